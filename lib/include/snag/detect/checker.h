@@ -1,0 +1,56 @@
+// Checking a sequence of frames that share one topology: the tree is built once per topology,
+// refit every frame (rebuilt when its quality degrades, per RebuildPolicy), traversed, and what
+// the double-precision filter cannot certify is decided by an ExactResolver.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "snag/detect/backend.h"
+#include "snag/detect/exact.h"
+#include "snag/detect/result.h"
+#include "snag/geom/vec3.h"
+
+namespace snag::detect {
+
+enum class RebuildPolicy { never, automatic, always };
+
+struct CheckSettings {
+  RebuildPolicy rebuild = RebuildPolicy::automatic;
+  /// With `automatic`, rebuild when the refit tree's quality (sum of internal-node half areas
+  /// over the root's half area) exceeds this factor times its value right after the last build.
+  double rebuild_threshold = 1.5;
+};
+
+class Checker {
+ public:
+  /// `resolver` decides what the filter cannot; it must not be null.
+  Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver, CheckSettings settings = {});
+  ~Checker();
+
+  /// Sets the triangles (indices into each frame's positions). Returns true when they differ
+  /// from the current ones, in which case the next check() builds a new tree.
+  bool set_triangles(std::span<const geom::Tri> triangles, int32_t vertex_count);
+
+  /// Checks one frame. `positions` has vertex_count entries and must stay valid during the call.
+  FrameResult check(std::span<const geom::Vec3d> positions);
+
+  int rebuild_count() const { return rebuilds_; }  ///< builds after the first of each topology
+  int build_count() const { return builds_; }
+  std::string_view backend_name() const { return backend_->name(); }
+  const CheckSettings& settings() const { return settings_; }
+
+ private:
+  std::unique_ptr<Backend> backend_;
+  std::shared_ptr<ExactResolver> resolver_;
+  CheckSettings settings_;
+  std::unique_ptr<struct Topology> topology_;
+  bool needs_build_ = true;
+  double built_quality_ = 0;
+  int builds_ = 0;
+  int rebuilds_ = 0;
+};
+
+}  // namespace snag::detect

@@ -1,0 +1,53 @@
+// What checking one frame produces: the intersecting triangle pairs with their kinds, the
+// degenerate faces, and what it took to decide them.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace snag::detect {
+
+/// `crossing`: not coplanar, each triangle has corners strictly on both sides of the other's
+/// plane, and they share a segment of positive length. `touching`: every other intersecting pair.
+enum class PairKind : uint8_t { crossing = 0, touching = 1 };
+
+inline std::string_view to_string(PairKind kind) { return kind == PairKind::crossing ? "crossing" : "touching"; }
+
+/// An intersecting pair of triangle ids, a < b.
+struct FacePair {
+  int32_t a;
+  int32_t b;
+  PairKind kind;
+  friend bool operator==(const FacePair&, const FacePair&) = default;
+};
+
+/// Seconds spent per stage of one frame (reading excluded).
+struct StageTimes {
+  double build = 0;     ///< tree (re)build, when one happened this frame
+  double refit = 0;
+  double traverse = 0;  ///< traversal with the filtered narrow phase
+  double exact = 0;     ///< uncertain tests decided with exact predicates
+  double classify = 0;  ///< sorting, deduplication and crossing/touching
+  double total() const { return build + refit + traverse + exact + classify; }
+};
+
+struct FrameResult {
+  std::vector<FacePair> pairs;       ///< sorted by (a, b), no duplicates
+  std::vector<int32_t> degenerate;   ///< zero-area triangles, sorted; left out of the search
+  int64_t candidate_pairs = 0;       ///< pairs whose boxes overlap
+  int64_t filtered_tests = 0;        ///< orientation-based tests decided by the double filter
+  int64_t uncertain_tests = 0;       ///< tests the filter could not certify, decided exactly
+  bool rebuilt = false;              ///< the tree was (re)built for this frame
+  double tree_quality = 0;           ///< sum of internal-node half areas over the root's
+  StageTimes times;
+
+  int64_t crossing_count() const {
+    int64_t n = 0;
+    for (const auto& p : pairs) n += p.kind == PairKind::crossing;
+    return n;
+  }
+  int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
+};
+
+}  // namespace snag::detect

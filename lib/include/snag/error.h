@@ -1,0 +1,46 @@
+// Typed errors thrown by the library; cli/main.cpp turns them into exit statuses.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace snag {
+
+/// Bad input: a file that cannot be read or that breaks its format's rules (exit status 3).
+/// The message names the file, the line (text formats) or byte offset (binary formats), what
+/// was found and what was expected.
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string path, int64_t line, std::string what, int64_t byte_offset = -1)
+      : std::runtime_error(format(path, line, byte_offset, what)),
+        path_(std::move(path)), line_(line), byte_offset_(byte_offset) {}
+  const std::string& path() const { return path_; }
+  int64_t line() const { return line_; }            ///< 1-based, 0 when not a line
+  int64_t byte_offset() const { return byte_offset_; }  ///< -1 when not a byte offset
+
+ private:
+  static std::string format(const std::string& path, int64_t line, int64_t offset, const std::string& what) {
+    std::string where = path;
+    if (line > 0) where += ":" + std::to_string(line);
+    if (offset >= 0) where += " (byte " + std::to_string(offset) + ")";
+    return where + ": " + what;
+  }
+  std::string path_;
+  int64_t line_;
+  int64_t byte_offset_;
+};
+
+/// A command line that cannot be honoured (exit status 2).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A broken invariant or a failing device call (exit status 4).
+class InternalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace snag

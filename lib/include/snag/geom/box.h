@@ -1,0 +1,71 @@
+// Axis-aligned boxes in single precision, rounded outward from double coordinates so that a
+// box always contains the exact (double) geometry it bounds. 24 bytes per box.
+#pragma once
+
+#include <cfloat>
+#include <cmath>
+
+#include "snag/geom/hd.h"
+#include "snag/geom/vec3.h"
+
+namespace snag::geom {
+
+struct Box3f {
+  float lo[3];
+  float hi[3];
+};
+
+/// The largest float not above x (x finite).
+SNAG_HD_INLINE float float_down(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = nextafterf(f, -FLT_MAX);
+  return f;
+}
+/// The smallest float not below x (x finite).
+SNAG_HD_INLINE float float_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = nextafterf(f, FLT_MAX);
+  return f;
+}
+
+SNAG_HD_INLINE Box3f empty_box() { return {{FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}}; }
+
+SNAG_HD_INLINE Box3f triangle_box(Vec3d a, Vec3d b, Vec3d c) {
+  Box3f box;
+  for (int k = 0; k < 3; ++k) {
+    double lo = fmin(fmin(coord(a, k), coord(b, k)), coord(c, k));
+    double hi = fmax(fmax(coord(a, k), coord(b, k)), coord(c, k));
+    box.lo[k] = float_down(lo);
+    box.hi[k] = float_up(hi);
+  }
+  return box;
+}
+
+SNAG_HD_INLINE Box3f merge(const Box3f& a, const Box3f& b) {
+  Box3f m;
+  for (int k = 0; k < 3; ++k) {
+    m.lo[k] = fminf(a.lo[k], b.lo[k]);
+    m.hi[k] = fmaxf(a.hi[k], b.hi[k]);
+  }
+  return m;
+}
+
+/// Closed boxes: touching boxes overlap, because touching triangles intersect.
+SNAG_HD_INLINE bool overlap(const Box3f& a, const Box3f& b) {
+  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
+
+SNAG_HD_INLINE bool contains(const Box3f& outer, const Box3f& inner) {
+  for (int k = 0; k < 3; ++k)
+    if (inner.lo[k] < outer.lo[k] || inner.hi[k] > outer.hi[k]) return false;
+  return true;
+}
+
+/// Half the surface area; the tree-quality measure sums it over internal nodes.
+SNAG_HD_INLINE double half_area(const Box3f& b) {
+  double dx = double(b.hi[0]) - b.lo[0], dy = double(b.hi[1]) - b.lo[1], dz = double(b.hi[2]) - b.lo[2];
+  return dx * dy + dy * dz + dz * dx;
+}
+
+}  // namespace snag::geom
