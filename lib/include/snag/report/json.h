@@ -1,0 +1,32 @@
+// report.json, schema "snag-report/1" (documented field by field in man/snag.1, REPORT.JSON):
+//
+//   { "schema": "snag-report/1", "snag": {"version"},
+//     "settings": {backend, backend_requested, threads, exact, weld, rebuild, rebuild_threshold,
+//                  fail_on, frames},
+//     "inputs":   {sequence, ids, files: [...], coincident_vertices, welded_vertices},
+//     "frames":   [ {frame, file, vertices, triangles, polygons, topology_changed, rebuilt,
+//                    tree_quality, counts: {pairs, crossing, touching, degenerate,
+//                    candidate_pairs, filtered_tests, uncertain_tests},
+//                    seconds: {read, build, refit, traverse, exact, classify, total},
+//                    pairs: [{a, b, kind, poly_a, poly_b}], degenerate: [{face, poly}]} ],
+//     "summary":  {frames_checked, frames_with_crossings, frames_with_pairs,
+//                  worst_frame: {frame, file, crossing, pairs} | null, pairs, crossing,
+//                  touching, degenerate, uncertain_tests, topology_changes, builds, rebuilds,
+//                  seconds: {check, read, wall}, failed} }
+//
+// Within schema version 1, fields may be added but none is removed or changes meaning.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "snag/report/report.h"
+
+namespace snag::report {
+
+inline constexpr std::string_view json_schema = "snag-report/1";
+
+/// The report as JSON text (two-space indentation, a trailing newline).
+std::string report_json(const Report& report);
+
+}  // namespace snag::report

@@ -1,0 +1,118 @@
+// What `snag check` reports: the settings and inputs of a run, one record per checked frame
+// with its pairs in the ids users see, and a summary. Writers (csv.h, json.h, write.h) turn a
+// Report into files; nothing here depends on how the frames were checked.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "snag/detect/result.h"
+
+namespace snag::report {
+
+/// When a run counts as failed (exit status 1): any crossing pair, any intersecting pair, never.
+enum class FailOn { crossing, any, none };
+
+std::string_view to_string(FailOn fail_on);
+/// "crossing", "any" or "none"; nullopt otherwise.
+std::optional<FailOn> parse_fail_on(std::string_view text);
+
+/// One intersecting pair: triangle ids a < b (the file's, after fan triangulation) and the
+/// ids of the file's faces (polygons) they come from.
+struct Pair {
+  int32_t a = 0;
+  int32_t b = 0;
+  detect::PairKind kind = detect::PairKind::crossing;
+  int32_t poly_a = 0;
+  int32_t poly_b = 0;
+  friend bool operator==(const Pair&, const Pair&) = default;
+};
+
+/// A zero-area triangle and the file's face it comes from.
+struct Face {
+  int32_t face = 0;
+  int32_t poly = 0;
+  friend bool operator==(const Face&, const Face&) = default;
+};
+
+struct FrameRecord {
+  int64_t frame = 0;       ///< frame number, from the file name (0 for a single file without one)
+  std::string file;        ///< path as resolved from the sequence spec
+  int32_t vertices = 0;
+  int32_t triangles = 0;
+  int64_t polygons = 0;    ///< faces as listed in the file
+  std::vector<Pair> pairs; ///< sorted by (a, b), unique
+  std::vector<Face> degenerate;  ///< sorted by face
+  int64_t candidate_pairs = 0;
+  int64_t filtered_tests = 0;
+  int64_t uncertain_tests = 0;   ///< tests the double filter left to exact arithmetic
+  bool topology_changed = false; ///< the face list differs from the previous checked frame's
+  bool rebuilt = false;          ///< the tree was built for this frame (always true for the first)
+  double tree_quality = 0;
+  detect::StageTimes times;      ///< checking only; times.total() is the frame's `seconds`
+  double read_seconds = 0;       ///< reading (and welding) the file
+
+  int64_t crossing_count() const;
+  int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
+};
+
+/// Builds a frame record from a checker's result. `source_polygon[t]` is triangle t's face id
+/// in the file (Mesh::source_polygon, one entry per triangle).
+FrameRecord make_frame_record(int64_t frame, std::string file, const detect::FrameResult& result,
+                              std::span<const int32_t> source_polygon, int32_t vertices,
+                              int64_t polygons);
+
+struct Settings {
+  std::string backend;            ///< backend that ran ("cpu")
+  std::string backend_requested;  ///< as asked on the command line ("auto", "cpu")
+  int threads = 0;                ///< worker threads used
+  std::string exact;              ///< who decides uncertain tests ("cgal")
+  std::optional<double> weld;     ///< --weld tolerance, if given
+  std::string rebuild;            ///< "never", "auto" or "always"
+  double rebuild_threshold = 0;   ///< quality factor that triggers a rebuild under "auto"
+  FailOn fail_on = FailOn::crossing;
+  std::optional<std::string> frames;  ///< --frames selection as given, if any
+};
+
+struct Inputs {
+  std::string sequence;         ///< the SEQUENCE argument as given
+  std::string ids = "file";     ///< "file" (snag's OBJ/PLY readers) or "assimp"
+  int64_t coincident_vertices = 0;  ///< exactly coincident vertices beyond the first of each spot, first frame
+  int64_t welded_vertices = 0;      ///< vertices merged into another by --weld, first frame
+};
+
+struct Report {
+  std::string snag_version;
+  Settings settings;
+  Inputs inputs;
+  std::vector<FrameRecord> frames;  ///< in checking order (increasing frame number)
+  int builds = 0;                   ///< tree builds, the first of each topology included
+  int rebuilds = 0;                 ///< builds beyond the first of each topology
+  double wall_seconds = 0;          ///< the whole run: reading, checking and accumulating
+};
+
+struct Summary {
+  int64_t frames_checked = 0;
+  int64_t frames_with_crossings = 0;
+  int64_t frames_with_pairs = 0;
+  /// Index into Report::frames of the frame with the most crossing pairs (ties: most pairs,
+  /// then the earliest); nullopt when no frame has a pair.
+  std::optional<size_t> worst_frame;
+  int64_t pairs = 0;
+  int64_t crossing = 0;
+  int64_t touching = 0;
+  int64_t degenerate = 0;
+  int64_t uncertain_tests = 0;
+  int64_t topology_changes = 0;
+  double check_seconds = 0;  ///< sum of the frames' checking times
+  double read_seconds = 0;
+  bool failed = false;       ///< the run fails under settings.fail_on
+};
+
+Summary summarize(const Report& report);
+
+}  // namespace snag::report

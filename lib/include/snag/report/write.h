@@ -1,0 +1,46 @@
+// Writing the report files of `--out DIR`, each complete or not at all: every file is written
+// to a temporary name in DIR and renamed over its final name only when all of them were
+// written, so a failure leaves no new file behind (and an earlier run's files untouched).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "snag/report/report.h"
+
+namespace snag::report {
+
+/// A report file or directory could not be created or written (exit status 3).
+class WriteError : public std::runtime_error {
+ public:
+  WriteError(const std::filesystem::path& path, const std::string& what)
+      : std::runtime_error(path.string() + ": " + what), path_(path) {}
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// One file to write: its name in the output directory and what writes its content.
+struct OutputFile {
+  std::string name;
+  std::function<void(std::ostream&)> write;
+};
+
+/// Writes every file into `dir` (created if missing) under a temporary name, then renames
+/// them all into place. Throws WriteError naming the path on failure, after removing every
+/// temporary file it created.
+void write_files_atomically(const std::filesystem::path& dir, const std::vector<OutputFile>& files);
+
+/// Checks up front that `dir` is, or can be created as, a writable directory (so a long run
+/// does not fail at its end); creates it. Throws WriteError otherwise.
+void prepare_output_dir(const std::filesystem::path& dir);
+
+/// Writes pairs.csv, frames.csv and report.json into `dir`, all complete or none.
+void write_reports(const std::filesystem::path& dir, const Report& report);
+
+}  // namespace snag::report

@@ -1,0 +1,379 @@
+// Report writers: exact CSV bytes for a hand-built run, report.json read back field by field,
+// and files written completely or not at all.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "snag/error.h"
+#include "snag/report/csv.h"
+#include "snag/report/json.h"
+#include "snag/report/report.h"
+#include "snag/report/write.h"
+
+namespace snag::report {
+namespace {
+
+namespace fs = std::filesystem;
+using detect::PairKind;
+
+/// Two frames recorded out of frame order (frame 12 first), one with an unsorted pair list
+/// from a hypothetical backend, a file name that needs quoting, and a quad split into triangles
+/// 2 and 3 (polygon 2).
+Report hand_built_report() {
+  Report r;
+  r.snag_version = "9.9.9";
+  r.settings.backend = "cpu";
+  r.settings.backend_requested = "auto";
+  r.settings.threads = 2;
+  r.settings.exact = "cgal";
+  r.settings.weld = 0.001;
+  r.settings.rebuild = "auto";
+  r.settings.rebuild_threshold = 1.5;
+  r.settings.fail_on = FailOn::crossing;
+  r.settings.frames = "10-12";
+  r.inputs.sequence = "shots/dress.%04d.obj";
+  r.inputs.coincident_vertices = 4;
+  r.inputs.welded_vertices = 3;
+
+  const std::vector<int32_t> polygons = {0, 1, 2, 2, 3};  // triangles 2 and 3 are one quad
+
+  detect::FrameResult f12;
+  f12.pairs = {{0, 4, PairKind::touching}};
+  f12.degenerate = {1};
+  f12.candidate_pairs = 9;
+  f12.filtered_tests = 30;
+  f12.uncertain_tests = 2;
+  f12.rebuilt = true;
+  f12.tree_quality = 2.5;
+  f12.times = {0.001, 0.0, 0.0025, 0.0005, 0.00025};
+  FrameRecord r12 = make_frame_record(12, "shots/dress,\"v2\".0012.obj", f12, polygons, 8, 4);
+  r12.topology_changed = true;
+  r12.read_seconds = 0.01;
+
+  detect::FrameResult f10;
+  f10.pairs = {{1, 3, PairKind::crossing}, {0, 2, PairKind::crossing}, {0, 3, PairKind::touching}};
+  f10.candidate_pairs = 5;
+  f10.filtered_tests = 20;
+  f10.tree_quality = 2.0;
+  f10.rebuilt = true;
+  f10.times = {0.002, 0.0, 0.001, 0.0, 0.0};
+  FrameRecord r10 = make_frame_record(10, "shots/dress.0010.obj", f10, polygons, 8, 4);
+  r10.read_seconds = 0.02;
+
+  detect::FrameResult f11;  // clean
+  f11.times = {0.0, 0.0001, 0.0002, 0.0, 0.0};
+  FrameRecord r11 = make_frame_record(11, "shots/dress.0011.obj", f11, polygons, 8, 4);
+
+  r.frames = {std::move(r12), std::move(r10), std::move(r11)};
+  r.builds = 2;
+  r.rebuilds = 0;
+  r.wall_seconds = 0.5;
+  return r;
+}
+
+std::string read_all(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A fresh directory under the system temporary directory, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("snag-report-test-" + std::to_string(::getpid()) + "-" +
+                                         std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::vector<std::string> entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(ReportRecord, CarriesPolygonIdsAndSortsPairs) {
+  const Report r = hand_built_report();
+  const FrameRecord& f10 = r.frames[1];
+  ASSERT_EQ(f10.pairs.size(), 3u);
+  EXPECT_EQ(f10.pairs[0], (Pair{0, 2, PairKind::crossing, 0, 2}));
+  EXPECT_EQ(f10.pairs[1], (Pair{0, 3, PairKind::touching, 0, 2}));
+  EXPECT_EQ(f10.pairs[2], (Pair{1, 3, PairKind::crossing, 1, 2}));
+  EXPECT_EQ(f10.crossing_count(), 2);
+  EXPECT_EQ(f10.touching_count(), 1);
+  EXPECT_EQ(f10.triangles, 5);
+  EXPECT_EQ(r.frames[0].degenerate, (std::vector<Face>{{1, 1}}));
+}
+
+TEST(ReportRecord, RejectsUnorderedPairAndUnknownTriangle) {
+  const std::vector<int32_t> polygons = {0, 1, 2};
+  detect::FrameResult bad;
+  bad.pairs = {{2, 1, PairKind::crossing}};
+  EXPECT_THROW(make_frame_record(1, "f.obj", bad, polygons, 3, 3), InternalError);
+  bad.pairs = {{1, 7, PairKind::crossing}};
+  EXPECT_THROW(make_frame_record(1, "f.obj", bad, polygons, 3, 3), InternalError);
+}
+
+TEST(ReportSummary, CountsWorstFrameAndVerdict) {
+  Report r = hand_built_report();
+  Summary s = summarize(r);
+  EXPECT_EQ(s.frames_checked, 3);
+  EXPECT_EQ(s.frames_with_crossings, 1);
+  EXPECT_EQ(s.frames_with_pairs, 2);
+  ASSERT_TRUE(s.worst_frame.has_value());
+  EXPECT_EQ(r.frames[*s.worst_frame].frame, 10);
+  EXPECT_EQ(s.pairs, 4);
+  EXPECT_EQ(s.crossing, 2);
+  EXPECT_EQ(s.touching, 2);
+  EXPECT_EQ(s.degenerate, 1);
+  EXPECT_EQ(s.uncertain_tests, 2);
+  EXPECT_EQ(s.topology_changes, 1);
+  EXPECT_DOUBLE_EQ(s.read_seconds, 0.03);
+  EXPECT_TRUE(s.failed);
+
+  // Frame 12 has only a touching pair: it fails under `any`, not under `crossing`.
+  r.frames.erase(r.frames.begin() + 1);
+  s = summarize(r);
+  EXPECT_EQ(r.frames[*s.worst_frame].frame, 12);
+  EXPECT_FALSE(s.failed);
+  r.settings.fail_on = FailOn::any;
+  EXPECT_TRUE(summarize(r).failed);
+  r.settings.fail_on = FailOn::none;
+  EXPECT_FALSE(summarize(r).failed);
+
+  r.frames.clear();
+  s = summarize(r);
+  EXPECT_FALSE(s.worst_frame.has_value());
+  EXPECT_FALSE(s.failed);
+}
+
+TEST(ReportFailOn, ParsesItsThreeValues) {
+  for (FailOn f : {FailOn::crossing, FailOn::any, FailOn::none})
+    EXPECT_EQ(parse_fail_on(to_string(f)), f);
+  EXPECT_FALSE(parse_fail_on("all").has_value());
+  EXPECT_FALSE(parse_fail_on("").has_value());
+}
+
+TEST(ReportCsv, PairsBytes) {
+  std::ostringstream out;
+  write_pairs_csv(out, hand_built_report());
+  EXPECT_EQ(out.str(),
+            "frame,face_a,face_b,kind,poly_a,poly_b\n"
+            "10,0,2,crossing,0,2\n"
+            "10,0,3,touching,0,2\n"
+            "10,1,3,crossing,1,2\n"
+            "12,0,4,touching,0,3\n");
+}
+
+TEST(ReportCsv, FramesBytes) {
+  std::ostringstream out;
+  write_frames_csv(out, hand_built_report());
+  EXPECT_EQ(out.str(),
+            "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
+            "topology_changed\n"
+            "10,shots/dress.0010.obj,5,3,2,1,0,0,0.003000,1,0\n"
+            "11,shots/dress.0011.obj,5,0,0,0,0,0,0.000300,0,0\n"
+            "12,\"shots/dress,\"\"v2\"\".0012.obj\",5,1,0,1,1,2,0.004250,1,1\n");
+}
+
+TEST(ReportCsv, EmptyRunHasHeadersOnly) {
+  Report r;
+  std::ostringstream pairs, frames;
+  write_pairs_csv(pairs, r);
+  write_frames_csv(frames, r);
+  EXPECT_EQ(pairs.str(), std::string(pairs_csv_header) + "\n");
+  EXPECT_EQ(frames.str(), std::string(frames_csv_header) + "\n");
+}
+
+TEST(ReportCsv, QuotesOnlyWhenNeeded) {
+  EXPECT_EQ(csv_field("plain/path.obj"), "plain/path.obj");
+  EXPECT_EQ(csv_field("a,b"), "\"a,b\"");
+  EXPECT_EQ(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(csv_field("line\nbreak"), "\"line\nbreak\"");
+}
+
+TEST(ReportJson, ParsesBackWithTheFields) {
+  const auto j = nlohmann::json::parse(report_json(hand_built_report()));
+  EXPECT_EQ(j.at("schema"), "snag-report/1");
+  EXPECT_EQ(j.at("snag").at("version"), "9.9.9");
+
+  const auto& set = j.at("settings");
+  EXPECT_EQ(set.at("backend"), "cpu");
+  EXPECT_EQ(set.at("backend_requested"), "auto");
+  EXPECT_EQ(set.at("threads"), 2);
+  EXPECT_EQ(set.at("exact"), "cgal");
+  EXPECT_DOUBLE_EQ(set.at("weld").get<double>(), 0.001);
+  EXPECT_EQ(set.at("rebuild"), "auto");
+  EXPECT_DOUBLE_EQ(set.at("rebuild_threshold").get<double>(), 1.5);
+  EXPECT_EQ(set.at("fail_on"), "crossing");
+  EXPECT_EQ(set.at("frames"), "10-12");
+
+  const auto& in = j.at("inputs");
+  EXPECT_EQ(in.at("sequence"), "shots/dress.%04d.obj");
+  EXPECT_EQ(in.at("ids"), "file");
+  EXPECT_EQ(in.at("files").size(), 3u);
+  EXPECT_EQ(in.at("coincident_vertices"), 4);
+  EXPECT_EQ(in.at("welded_vertices"), 3);
+
+  const auto& frames = j.at("frames");
+  ASSERT_EQ(frames.size(), 3u);
+  const auto& f10 = frames.at(1);
+  EXPECT_EQ(f10.at("frame"), 10);
+  EXPECT_EQ(f10.at("file"), "shots/dress.0010.obj");
+  EXPECT_EQ(f10.at("vertices"), 8);
+  EXPECT_EQ(f10.at("triangles"), 5);
+  EXPECT_EQ(f10.at("polygons"), 4);
+  EXPECT_EQ(f10.at("topology_changed"), false);
+  EXPECT_EQ(f10.at("rebuilt"), true);
+  EXPECT_DOUBLE_EQ(f10.at("tree_quality").get<double>(), 2.0);
+  EXPECT_EQ(f10.at("counts").at("pairs"), 3);
+  EXPECT_EQ(f10.at("counts").at("crossing"), 2);
+  EXPECT_EQ(f10.at("counts").at("touching"), 1);
+  EXPECT_EQ(f10.at("counts").at("degenerate"), 0);
+  EXPECT_EQ(f10.at("counts").at("candidate_pairs"), 5);
+  EXPECT_EQ(f10.at("counts").at("filtered_tests"), 20);
+  EXPECT_EQ(f10.at("counts").at("uncertain_tests"), 0);
+  EXPECT_DOUBLE_EQ(f10.at("seconds").at("read").get<double>(), 0.02);
+  EXPECT_DOUBLE_EQ(f10.at("seconds").at("build").get<double>(), 0.002);
+  EXPECT_DOUBLE_EQ(f10.at("seconds").at("traverse").get<double>(), 0.001);
+  EXPECT_DOUBLE_EQ(f10.at("seconds").at("total").get<double>(), 0.003);
+  ASSERT_EQ(f10.at("pairs").size(), 3u);
+  EXPECT_EQ(f10.at("pairs").at(2),
+            (nlohmann::json{{"a", 1}, {"b", 3}, {"kind", "crossing"}, {"poly_a", 1}, {"poly_b", 2}}));
+  EXPECT_TRUE(f10.at("degenerate").empty());
+
+  const auto& f12 = frames.at(0);
+  EXPECT_EQ(f12.at("file"), "shots/dress,\"v2\".0012.obj");
+  EXPECT_EQ(f12.at("topology_changed"), true);
+  EXPECT_EQ(f12.at("degenerate"), (nlohmann::json::array({{{"face", 1}, {"poly", 1}}})));
+  EXPECT_EQ(f12.at("counts").at("uncertain_tests"), 2);
+
+  const auto& s = j.at("summary");
+  EXPECT_EQ(s.at("frames_checked"), 3);
+  EXPECT_EQ(s.at("frames_with_crossings"), 1);
+  EXPECT_EQ(s.at("frames_with_pairs"), 2);
+  EXPECT_EQ(s.at("worst_frame").at("frame"), 10);
+  EXPECT_EQ(s.at("worst_frame").at("file"), "shots/dress.0010.obj");
+  EXPECT_EQ(s.at("worst_frame").at("crossing"), 2);
+  EXPECT_EQ(s.at("worst_frame").at("pairs"), 3);
+  EXPECT_EQ(s.at("pairs"), 4);
+  EXPECT_EQ(s.at("crossing"), 2);
+  EXPECT_EQ(s.at("touching"), 2);
+  EXPECT_EQ(s.at("degenerate"), 1);
+  EXPECT_EQ(s.at("uncertain_tests"), 2);
+  EXPECT_EQ(s.at("topology_changes"), 1);
+  EXPECT_EQ(s.at("builds"), 2);
+  EXPECT_EQ(s.at("rebuilds"), 0);
+  EXPECT_NEAR(s.at("seconds").at("check").get<double>(), 0.00755, 1e-12);
+  EXPECT_DOUBLE_EQ(s.at("seconds").at("wall").get<double>(), 0.5);
+  EXPECT_EQ(s.at("failed"), true);
+}
+
+TEST(ReportJson, NullsForAbsentSettingsAndWorstFrame) {
+  Report r;
+  r.settings.fail_on = FailOn::none;
+  const auto j = nlohmann::json::parse(report_json(r));
+  EXPECT_TRUE(j.at("settings").at("weld").is_null());
+  EXPECT_TRUE(j.at("settings").at("frames").is_null());
+  EXPECT_TRUE(j.at("summary").at("worst_frame").is_null());
+  EXPECT_TRUE(j.at("frames").empty());
+  EXPECT_EQ(j.at("summary").at("failed"), false);
+}
+
+TEST(ReportWrite, WritesTheThreeFilesAndNothingElse) {
+  TempDir tmp;
+  const fs::path out = tmp.path() / "nested" / "report";
+  const Report r = hand_built_report();
+  write_reports(out, r);
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+  std::ostringstream pairs;
+  write_pairs_csv(pairs, r);
+  EXPECT_EQ(read_all(out / "pairs.csv"), pairs.str());
+  EXPECT_EQ(nlohmann::json::parse(read_all(out / "report.json")).at("schema"), "snag-report/1");
+
+  // A second run replaces the files in place.
+  Report r2 = r;
+  r2.frames.resize(1);
+  write_reports(out, r2);
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+  EXPECT_EQ(read_all(out / "pairs.csv"),
+            "frame,face_a,face_b,kind,poly_a,poly_b\n12,0,4,touching,0,3\n");
+}
+
+TEST(ReportWrite, OutputPathIsAFile) {
+  TempDir tmp;
+  const fs::path out = tmp.path() / "not-a-dir";
+  std::ofstream(out) << "x";
+  EXPECT_THROW(write_reports(out, hand_built_report()), WriteError);
+  EXPECT_THROW(prepare_output_dir(out), WriteError);
+  EXPECT_EQ(read_all(out), "x");
+  EXPECT_EQ(entries(tmp.path()), (std::vector<std::string>{"not-a-dir"}));
+}
+
+TEST(ReportWrite, OutputPathUnderAFile) {
+  TempDir tmp;
+  std::ofstream(tmp.path() / "file") << "x";
+  const fs::path out = tmp.path() / "file" / "report";
+  EXPECT_THROW(prepare_output_dir(out), WriteError);
+  EXPECT_THROW(write_reports(out, hand_built_report()), WriteError);
+  EXPECT_EQ(entries(tmp.path()), (std::vector<std::string>{"file"}));
+}
+
+TEST(ReportWrite, UnwritableDirectoryLeavesNothing) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: directory permissions do not stop writes";
+  TempDir tmp;
+  const fs::path out = tmp.path() / "ro";
+  fs::create_directories(out);
+  fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec);
+  EXPECT_THROW(prepare_output_dir(out), WriteError);
+  EXPECT_THROW(write_reports(out, hand_built_report()), WriteError);
+  fs::permissions(out, fs::perms::owner_all);
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(ReportWrite, FailureInALaterFileLeavesNoFileAndKeepsTheOldOnes) {
+  // Works as root too: the failure comes from the writer, after earlier files were written
+  // to their temporaries.
+  TempDir tmp;
+  std::ofstream(tmp.path() / "first.txt") << "old";
+  const std::vector<OutputFile> files = {
+      {"first.txt", [](std::ostream& out) { out << "new"; }},
+      {"second.txt", [](std::ostream&) { throw std::runtime_error("writer failed"); }},
+  };
+  EXPECT_THROW(write_files_atomically(tmp.path(), files), std::runtime_error);
+  EXPECT_EQ(entries(tmp.path()), (std::vector<std::string>{"first.txt"}));
+  EXPECT_EQ(read_all(tmp.path() / "first.txt"), "old");
+}
+
+TEST(ReportWrite, StreamFailureIsAWriteError) {
+  TempDir tmp;
+  const std::vector<OutputFile> files = {
+      {"bad.txt", [](std::ostream& out) { out.setstate(std::ios::badbit); }},
+  };
+  EXPECT_THROW(write_files_atomically(tmp.path(), files), WriteError);
+  EXPECT_TRUE(entries(tmp.path()).empty());
+}
+
+}  // namespace
+}  // namespace snag::report
