@@ -1,0 +1,289 @@
+// `snag bench cpu`: snag's CPU path and CGAL's self_intersections timed side by side on the
+// same frames (generated cloth at the paper's sizes, the shared cloth-ball frames, and any
+// --input sequence), with a check that both found the same pairs. A benchmark, not a test:
+// it prints a table and fails only when the pairs differ.
+#include <omp.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "backend_factory.h"
+#include "commands.h"
+#include "snag/detect/checker.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "snag/seq/sequence.h"
+#include "snag/validators/cgal_reference.h"
+#include "snag/validators/cgal_resolver.h"
+
+extern char** environ;
+
+namespace snag::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+/// Frames simulated before the timed ones, so the cloth has draped over the sphere and folded
+/// through itself (the generator runs at 30 frames per second).
+constexpr int settle_frames = 45;
+
+struct Case {
+  std::string name;
+  std::vector<fs::path> files;
+};
+
+struct Row {
+  std::string name;
+  int triangles = 0;
+  int frames = 0;
+  int timed = 0;
+  double build = 0, refit = 0, traverse = 0, exact = 0, total = 0, cgal = 0;
+  int64_t pairs = 0;
+  bool same = true;
+  std::string note;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// A temporary directory removed with everything in it when the bench ends.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() /
+            ("snag-bench-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// The sample generator: --generator, else beside this executable (installed layout), else in
+/// the build tree's samples/ (build layout), else `snag-cloth` on PATH.
+std::string find_generator(const BenchOptions& o) {
+  if (!o.generator.empty()) return o.generator;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (const fs::path& candidate :
+         {self.parent_path() / "snag-cloth", self.parent_path().parent_path() / "samples" / "snag-cloth"})
+      if (fs::exists(candidate, ec)) return candidate.string();
+  }
+  return "snag-cloth";
+}
+
+void run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0)
+    throw UsageError("cannot run the sample generator '" + args[0] +
+                     "' (build it, or give its path with --generator)");
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw InternalError("the sample generator '" + args[0] + "' failed");
+}
+
+std::vector<fs::path> generated_cloth(const BenchOptions& o, int triangles, const fs::path& dir) {
+  const int total = settle_frames + std::max(1, o.frames);
+  std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total
+            << " frames\n";
+  run_program({find_generator(o), "--triangles", std::to_string(triangles), "--frames",
+               std::to_string(total), "--output-dir", dir.string(), "--prefix", "cloth",
+               "--quiet"});
+  std::vector<fs::path> files;
+  for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
+  if (files.size() > static_cast<size_t>(std::max(1, o.frames)))
+    files.erase(files.begin(), files.end() - std::max(1, o.frames));
+  return files;
+}
+
+std::vector<std::pair<int32_t, int32_t>> pair_ids(const detect::FrameResult& r) {
+  std::vector<std::pair<int32_t, int32_t>> ids;
+  ids.reserve(r.pairs.size());
+  for (const auto& p : r.pairs) ids.emplace_back(p.a, p.b);
+  return ids;
+}
+
+Row run_case(const Case& c, const BenchOptions& o) {
+  std::cerr << "snag bench: " << c.name << ": reading " << c.files.size() << " frames\n";
+  std::vector<mesh::Mesh> meshes;
+  for (const fs::path& f : c.files) meshes.push_back(io::read_mesh(f));
+  if (meshes.empty()) throw InputError(c.name, 0, "no frames");
+  const mesh::Mesh& first = meshes.front();
+  for (const mesh::Mesh& m : meshes)
+    if (m.positions.size() != first.positions.size() || m.triangles.size() != first.triangles.size())
+      throw InputError(c.name, 0, "frames of a benchmark case must share one topology");
+  const int32_t vertices = static_cast<int32_t>(first.positions.size());
+
+  Row row;
+  row.name = c.name;
+  row.triangles = static_cast<int>(first.triangles.size());
+  row.frames = static_cast<int>(meshes.size());
+
+  // Two checkers over the same frames: one refits (the steady state of a sequence), one
+  // rebuilds every frame (the build time per frame).
+  auto resolver = validators::make_cgal_resolver();
+  detect::Checker refitting(make_backend("cpu", o.threads), resolver, {detect::RebuildPolicy::never});
+  detect::Checker rebuilding(make_backend("cpu", o.threads), resolver, {detect::RebuildPolicy::always});
+  refitting.set_triangles(first.triangles, vertices);
+  rebuilding.set_triangles(first.triangles, vertices);
+
+  // Frames are visited cyclically, so a two-frame case still gives --frames timed samples.
+  const int iterations = std::max(0, o.warmup) + std::max(1, o.frames);
+  std::vector<double> build, refit, traverse, exact, total, cgal;
+  for (int it = 0; it < iterations; ++it) {
+    const mesh::Mesh& m = meshes[it % meshes.size()];
+    const detect::FrameResult built = rebuilding.check(m.positions);
+    const detect::FrameResult r = refitting.check(m.positions);
+    const auto cgal_started = Clock::now();
+    const auto reference = validators::cgal_self_intersections(m.positions, m.triangles);
+    const double cgal_seconds = std::chrono::duration<double>(Clock::now() - cgal_started).count();
+    if (pair_ids(r) != reference || pair_ids(built) != reference) {
+      row.same = false;
+      row.note = "frame " + std::to_string(it % meshes.size()) + ": snag " +
+                 std::to_string(r.pairs.size()) + " pairs, CGAL " + std::to_string(reference.size());
+    }
+    if (it < o.warmup) continue;
+    build.push_back(built.times.build);
+    refit.push_back(r.times.refit);
+    traverse.push_back(r.times.traverse);
+    exact.push_back(r.times.exact + r.times.classify);
+    total.push_back(r.times.total());
+    cgal.push_back(cgal_seconds);
+    row.pairs = static_cast<int64_t>(r.pairs.size());
+  }
+  row.timed = static_cast<int>(total.size());
+  row.build = median(build);
+  row.refit = median(refit);
+  row.traverse = median(traverse);
+  row.exact = median(exact);
+  row.total = median(total);
+  row.cgal = median(cgal);
+  return row;
+}
+
+void print_table(const std::vector<Row>& rows, int threads) {
+  std::printf("snag bench cpu: %d threads; medians over the timed frames, milliseconds per frame\n",
+              threads);
+  std::printf("snag total = refit + traverse + exact/classify (the tree is built once per "
+              "topology; build is the time of one rebuild)\n\n");
+  std::printf("%-22s %9s %6s %9s %9s %9s %9s %9s %9s %9s %8s %5s\n", "case", "triangles", "frames",
+              "build", "refit", "traverse", "exact", "total", "CGAL", "CGAL/snag", "pairs", "same");
+  for (const Row& r : rows) {
+    const double ratio = r.total > 0 ? r.cgal / r.total : 0;
+    std::printf("%-22s %9d %6d %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %8.1fx %8lld %5s\n",
+                r.name.c_str(), r.triangles, r.timed, r.build * 1e3, r.refit * 1e3,
+                r.traverse * 1e3, r.exact * 1e3, r.total * 1e3, r.cgal * 1e3, ratio,
+                static_cast<long long>(r.pairs), r.same ? "yes" : "NO");
+    if (!r.note.empty()) std::printf("  %s\n", r.note.c_str());
+  }
+}
+
+}  // namespace
+
+CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks (not tests)");
+  bench->require_subcommand(1, 1);
+  CLI::App* cpu = bench->add_subcommand(
+      "cpu", "Time snag's CPU path and CGAL's self_intersections side by side on the same frames");
+  cpu->add_option("--sizes", o.sizes,
+                  "Generated cloth sizes in triangles (0 or an empty list: none)")
+      ->type_name("T,...")
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cpu->add_option("--frames", o.frames, "Timed frames per case, after the warm-up")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cpu->add_option("--warmup", o.warmup, "Untimed frames per case before the timed ones")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cpu->add_option("--data", o.data_dir,
+                  "The shared data folder; its scalable-ccd/cloth-ball frames are a case when "
+                  "present (default: $SNAG_DATA_DIR, else the one known at build time)")
+      ->type_name("DIR");
+  cpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")->type_name("SEQUENCE");
+  cpu->add_option("--generator", o.generator,
+                  "The snag-cloth sample generator (default: beside snag, in the build tree, "
+                  "or on PATH)")
+      ->type_name("PATH");
+  cpu->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  return cpu;
+}
+
+int run_bench_cpu(const BenchOptions& o) {
+  ScratchDir scratch;
+  std::vector<Case> cases;
+  for (int size : o.sizes) {
+    if (size <= 0) continue;
+    const fs::path dir = scratch.path() / std::to_string(size);
+    cases.push_back({"cloth " + std::to_string(size), generated_cloth(o, size, dir)});
+  }
+
+  fs::path data = o.data_dir;
+  if (data.empty()) {
+    if (const char* env = std::getenv("SNAG_DATA_DIR"); env && *env) data = env;
+#ifdef SNAG_DATA_DIR_DEFAULT
+    else data = SNAG_DATA_DIR_DEFAULT;
+#endif
+  }
+  const fs::path ball = data / "scalable-ccd" / "cloth-ball";
+  if (!data.empty() && fs::is_directory(ball)) {
+    Case c{"cloth-ball", {}};
+    for (const seq::Frame& f : seq::resolve_sequence(ball.string())) c.files.push_back(f.path);
+    cases.push_back(std::move(c));
+  } else if (!o.data_dir.empty()) {
+    throw UsageError("--data " + o.data_dir + ": no scalable-ccd/cloth-ball folder in it");
+  } else {
+    std::cerr << "snag bench: no shared data folder (" << ball.string()
+              << "); the cloth-ball case is left out\n";
+  }
+
+  for (const std::string& input : o.inputs) {
+    Case c{fs::path(input).filename().string(), {}};
+    for (const seq::Frame& f : seq::resolve_sequence(input)) c.files.push_back(f.path);
+    cases.push_back(std::move(c));
+  }
+  if (cases.empty()) throw UsageError("nothing to time: no --sizes, no data folder, no --input");
+
+  std::vector<Row> rows;
+  for (const Case& c : cases) rows.push_back(run_case(c, o));
+  print_table(rows, o.threads > 0 ? o.threads : omp_get_max_threads());
+  const bool all_same = std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; });
+  if (!all_same) throw InternalError("snag and CGAL found different pairs (see the table)");
+  return 0;
+}
+
+}  // namespace snag::cli

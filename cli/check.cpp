@@ -1,0 +1,272 @@
+// `snag check SEQUENCE`: every frame of a sequence checked for self-intersections, a summary on
+// standard output and, with --out, the reports.
+#include <omp.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "backend_factory.h"
+#include "commands.h"
+#include "progress.h"
+#include "snag/detect/checker.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "snag/mesh/weld.h"
+#include "snag/report/report.h"
+#include "snag/report/write.h"
+#include "snag/seq/sequence.h"
+#include "snag/validators/cgal_resolver.h"
+
+namespace snag::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+detect::RebuildPolicy rebuild_policy(const std::string& name) {
+  if (name == "never") return detect::RebuildPolicy::never;
+  if (name == "always") return detect::RebuildPolicy::always;
+  return detect::RebuildPolicy::automatic;
+}
+
+/// The frames to check, in increasing frame number.
+std::vector<seq::Frame> resolve_frames(const CheckOptions& options) {
+  std::vector<seq::Frame> frames = seq::resolve_sequence(options.sequence);
+  if (options.frames.empty()) return frames;
+  return seq::select_frames(frames, seq::FrameSelection::parse(options.frames));
+}
+
+/// The triangles the checker sees: the file's, with each corner replaced by its weld
+/// representative when welding (geometry then comes from the representative's position).
+std::vector<geom::Tri> welded_triangles(const mesh::Mesh& mesh, std::span<const int32_t> representative) {
+  std::vector<geom::Tri> triangles = mesh.triangles;
+  if (representative.empty()) return triangles;
+  for (geom::Tri& t : triangles)
+    for (int32_t& v : t.v) v = representative[v];
+  return triangles;
+}
+
+bool same_faces(const std::vector<geom::Tri>& a, const std::vector<geom::Tri>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (a[i].v[k] != b[i].v[k]) return false;
+  return true;
+}
+
+std::string frame_note(const report::FrameRecord& r) {
+  std::string note = "frame " + std::to_string(r.frame) + ": ";
+  if (r.pairs.empty()) {
+    note += "clean";
+  } else {
+    note += std::to_string(r.crossing_count()) + " crossing, " + std::to_string(r.touching_count()) +
+            " touching";
+  }
+  if (!r.degenerate.empty()) note += ", " + std::to_string(r.degenerate.size()) + " degenerate";
+  if (r.topology_changed) note += " (topology changed)";
+  return note;
+}
+
+std::string fixed(double value, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+std::string plural(int64_t n, const std::string& word) {
+  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+}
+
+void print_summary(std::ostream& out, const report::Report& r, const report::Summary& s,
+                   const std::string& out_dir) {
+  out << "frames checked       " << s.frames_checked << "\n";
+  out << "frames with crossing " << s.frames_with_crossings << "\n";
+  out << "worst frame          ";
+  if (s.worst_frame) {
+    const report::FrameRecord& w = r.frames[*s.worst_frame];
+    out << w.frame << " (" << w.file << "): " << w.crossing_count() << " crossing, "
+        << w.touching_count() << " touching\n";
+  } else {
+    out << "none\n";
+  }
+  out << "pairs                " << s.pairs << " (" << s.crossing << " crossing, " << s.touching
+      << " touching)\n";
+  if (s.degenerate > 0) out << "degenerate faces     " << s.degenerate << "\n";
+  const double per_frame = s.frames_checked > 0 ? s.check_seconds / s.frames_checked : 0.0;
+  out << "time                 " << fixed(s.check_seconds, 3) << " s checking ("
+      << fixed(per_frame * 1e3, 2) << " ms per frame), " << fixed(s.read_seconds, 3)
+      << " s reading, " << fixed(r.wall_seconds, 3) << " s in all\n";
+  out << "tree                 " << plural(r.builds, "build") << ", "
+      << plural(r.rebuilds, "rebuild") << " (--rebuild " << r.settings.rebuild << "), "
+      << plural(s.topology_changes, "topology change") << "\n";
+  if (!out_dir.empty())
+    out << "reports              " << (std::filesystem::path(out_dir) / "").string()
+        << "{pairs.csv,frames.csv,report.json}\n";
+}
+
+}  // namespace
+
+CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "check", "Check every frame of SEQUENCE for self-intersections and report them");
+  cmd->add_option("SEQUENCE", o.sequence,
+                  "One OBJ/PLY (or other mesh) file, a directory of them, a pattern with %04d, "
+                  "####, @ or $F4, or a quoted glob")
+      ->required();
+  cmd->add_option("-o,--out", o.out_dir,
+                  "Write pairs.csv, frames.csv and report.json into DIR (created if missing)")
+      ->type_name("DIR");
+  cmd->add_option("--frames", o.frames, "Check only these frames: 1-240, 1-240x5, 1-10,20-30")
+      ->type_name("SEL");
+  cmd->add_option("--weld", o.weld,
+                  "Vertices closer than TOL count as one for adjacency (reports keep the "
+                  "file's ids)")
+      ->type_name("TOL")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--rebuild", o.rebuild,
+                  "When to rebuild the tree instead of refitting it: never, auto (when its "
+                  "quality degrades past --rebuild-threshold), always")
+      ->type_name("POLICY")
+      ->check(CLI::IsMember({"never", "auto", "always"}))
+      ->capture_default_str();
+  cmd->add_option("--rebuild-threshold", o.rebuild_threshold,
+                  "With --rebuild auto: rebuild when the refit tree's quality exceeds this "
+                  "factor times its quality after the last build")
+      ->type_name("FACTOR")
+      ->check(CLI::Range(1.0, 1e9))
+      ->capture_default_str();
+  cmd->add_option("--backend", o.backend, "Detection backend: auto, cpu (cuda: not in this version)")
+      ->type_name("NAME")
+      ->check(CLI::IsMember(std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))
+      ->capture_default_str();
+  cmd->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--fail-on", o.fail_on,
+                  "Exit with status 1 when a frame has: crossing pairs, any pair, or none (never)")
+      ->type_name("WHAT")
+      ->check(CLI::IsMember({"crossing", "any", "none"}))
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", o.quiet, "No progress and no warnings on standard error");
+  return cmd;
+}
+
+int run_check(const CheckOptions& o) {
+  const auto started = Clock::now();
+  const auto fail_on = report::parse_fail_on(o.fail_on);
+  if (!fail_on) throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
+  if (o.weld && !(*o.weld >= 0)) throw UsageError("--weld: TOL must be a number >= 0");
+
+  const std::vector<seq::Frame> frames = resolve_frames(o);
+  // The output directory is checked before the first frame, so an unusable --out fails at
+  // once rather than after an hour of checking.
+  if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
+
+  auto backend = make_backend(o.backend, o.threads);
+  const std::string backend_name(backend->name());
+  detect::CheckSettings settings;
+  settings.rebuild = rebuild_policy(o.rebuild);
+  settings.rebuild_threshold = o.rebuild_threshold;
+  detect::Checker checker(std::move(backend), validators::make_cgal_resolver(), settings);
+
+  report::Report rep;
+  rep.snag_version = SNAG_VERSION;
+  rep.settings.backend = backend_name;
+  rep.settings.backend_requested = o.backend;
+  rep.settings.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  rep.settings.exact = "cgal";
+  rep.settings.weld = o.weld;
+  rep.settings.rebuild = o.rebuild;
+  rep.settings.rebuild_threshold = o.rebuild_threshold;
+  rep.settings.fail_on = *fail_on;
+  if (!o.frames.empty()) rep.settings.frames = o.frames;
+  rep.inputs.sequence = o.sequence;
+  rep.frames.reserve(frames.size());
+
+  Progress progress(static_cast<int64_t>(frames.size()), o.quiet);
+  std::vector<geom::Tri> file_triangles;   // the current topology, as the file lists it
+  std::vector<int32_t> representative;     // weld representative per vertex (empty: no weld)
+  int32_t vertex_count = 0;
+  std::string first_file;
+  bool any_assimp = false;
+
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const seq::Frame& frame = frames[i];
+    const std::string file = frame.path.string();
+    const auto read_started = Clock::now();
+    mesh::Mesh mesh = io::read_mesh(frame.path);
+    any_assimp = any_assimp || mesh.ids_from_assimp;
+    const int32_t vertices = static_cast<int32_t>(mesh.positions.size());
+
+    bool topology_changed = false;
+    if (i == 0) {
+      vertex_count = vertices;
+      first_file = file;
+    } else if (vertices != vertex_count) {
+      throw InputError(file, 0,
+                       "has " + std::to_string(vertices) + " vertices, but the first frame (" +
+                           first_file + ") has " + std::to_string(vertex_count) +
+                           "; every frame of a sequence must have the same vertices");
+    } else {
+      topology_changed = !same_faces(mesh.triangles, file_triangles);
+    }
+
+    if (i == 0 || topology_changed) {
+      // Welding is decided once per topology, on its first frame: seams stay closed while the
+      // cloth moves, and a weld that changed from frame to frame would rebuild the tree.
+      if (o.weld) {
+        representative = mesh::weld_representatives(mesh.positions, *o.weld);
+        int64_t welded = 0;
+        for (size_t v = 0; v < representative.size(); ++v) welded += representative[v] != static_cast<int32_t>(v);
+        if (i == 0) rep.inputs.welded_vertices = welded;
+      } else if (i == 0) {
+        const int64_t coincident = mesh::count_coincident_vertices(mesh.positions);
+        rep.inputs.coincident_vertices = coincident;
+        if (coincident > 0 && !o.quiet)
+          progress.message("snag: warning: " + file + ": " + std::to_string(coincident) +
+                           (coincident == 1 ? " vertex coincides" : " vertices coincide") +
+                           " exactly with another vertex but are separate vertices; "
+                           "unwelded seams are reported as intersections (use --weld TOL)");
+      }
+      file_triangles = mesh.triangles;
+      checker.set_triangles(welded_triangles(mesh, representative), vertex_count);
+    }
+    const double read_seconds = seconds_since(read_started);
+
+    const detect::FrameResult result = checker.check(mesh.positions);
+    report::FrameRecord record = report::make_frame_record(
+        frame.number, file, result, mesh.source_polygon, vertices, mesh.polygon_count);
+    record.topology_changed = topology_changed;
+    record.read_seconds = read_seconds;
+    progress.update(static_cast<int64_t>(i) + 1, frame_note(record));
+    rep.frames.push_back(std::move(record));
+  }
+  progress.finish();
+
+  rep.inputs.ids = any_assimp ? "assimp" : "file";
+  rep.builds = checker.build_count();
+  rep.rebuilds = checker.rebuild_count();
+  rep.wall_seconds = seconds_since(started);
+  const report::Summary summary = report::summarize(rep);
+
+  // Only now, with every frame read and checked, do report files appear.
+  if (!o.out_dir.empty()) report::write_reports(o.out_dir, rep);
+
+  print_summary(std::cout, rep, summary, o.out_dir);
+  std::cout.flush();
+  if (summary.failed && !o.quiet)
+    std::cerr << "snag: intersections found (--fail-on " << o.fail_on << "): exit status 1\n";
+  return summary.failed ? 1 : 0;
+}
+
+}  // namespace snag::cli

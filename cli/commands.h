@@ -1,0 +1,46 @@
+// The subcommands of `snag`: each file registers its options on the CLI11 app and runs the
+// command, returning its exit status (0, or 1 when intersections fail the run). Errors are
+// thrown, and cli/main.cpp turns them into exit statuses.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace snag::cli {
+
+/// Options of `snag check`, filled by CLI11.
+struct CheckOptions {
+  std::string sequence;
+  std::string out_dir;
+  std::string frames;
+  std::optional<double> weld;
+  std::string rebuild = "auto";
+  double rebuild_threshold = 1.5;
+  std::string backend = "auto";
+  int threads = 0;
+  std::string fail_on = "crossing";
+  bool quiet = false;
+};
+
+CLI::App* add_check_command(CLI::App& app, CheckOptions& options);
+int run_check(const CheckOptions& options);
+
+/// Options of `snag bench cpu`, filled by CLI11.
+struct BenchOptions {
+  std::vector<int> sizes = {2244, 27030, 35992};
+  int frames = 5;
+  int warmup = 1;
+  std::string data_dir;
+  std::vector<std::string> inputs;
+  std::string generator;
+  int threads = 0;
+};
+
+/// Adds `bench` and its `cpu` subcommand; returns the `cpu` subcommand.
+CLI::App* add_bench_command(CLI::App& app, BenchOptions& options);
+int run_bench_cpu(const BenchOptions& options);
+
+}  // namespace snag::cli

@@ -1,0 +1,57 @@
+// snag: finds self-intersections in cloth animation sequences.
+//
+// This file holds the one place where exceptions become exit statuses:
+//   0 clean, 1 intersections found (per --fail-on; returned by the command, not thrown),
+//   2 usage error, 3 input or output error, 4 internal error.
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "snag/error.h"
+#include "snag/report/write.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"snag finds where a cloth animation goes through itself: every intersecting "
+               "triangle pair of every frame, labelled crossing or touching.",
+               "snag"};
+  try {
+    app.set_version_flag("--version", SNAG_VERSION);
+    app.require_subcommand(1, 1);
+    app.footer(
+        "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
+        "3 input or output error, 4 internal error. See snag(1).");
+    snag::cli::CheckOptions check;
+    CLI::App* check_command = snag::cli::add_check_command(app, check);
+    snag::cli::BenchOptions bench;
+    CLI::App* bench_cpu_command = snag::cli::add_bench_command(app, bench);
+
+    app.parse(argc, argv);
+    if (check_command->parsed()) return snag::cli::run_check(check);
+    if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);
+    throw snag::InternalError("no subcommand ran");
+  } catch (const CLI::ParseError& e) {
+    // --help and --version arrive here too, with CLI11's success code.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const snag::UsageError& e) {
+    std::cerr << "snag: error: " << e.what() << "\nRun with --help for more information.\n";
+    return 2;
+  } catch (const snag::InputError& e) {
+    std::cerr << "snag: input error: " << e.what() << "\n";
+    return 3;
+  } catch (const snag::report::WriteError& e) {
+    std::cerr << "snag: cannot write the report: " << e.what() << "\n";
+    return 3;
+  } catch (const snag::InternalError& e) {
+    std::cerr << "snag: internal error: " << e.what() << "\n";
+    return 4;
+  } catch (const std::exception& e) {
+    std::cerr << "snag: internal error: " << e.what() << "\n";
+    return 4;
+  } catch (...) {
+    std::cerr << "snag: internal error: unknown exception\n";
+    return 4;
+  }
+}
