@@ -38,7 +38,7 @@ class Backend {
  public:
   virtual ~Backend() = default;
   virtual std::string_view name() const = 0;
-  /// A new topology; the backend keeps what it needs of it until the next call.
+  /// A new topology, owned by the caller and valid until the next call.
   virtual void set_topology(const Topology& topology) = 0;
   /// This frame's positions (vertex_count entries); valid until the next call.
   virtual void set_positions(std::span<const geom::Vec3d> positions) = 0;

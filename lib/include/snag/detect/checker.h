@@ -37,7 +37,7 @@ class Checker {
   /// Checks one frame. `positions` has vertex_count entries and must stay valid during the call.
   FrameResult check(std::span<const geom::Vec3d> positions);
 
-  int rebuild_count() const { return rebuilds_; }  ///< builds after the first of each topology
+  int rebuild_count() const { return rebuilds_; }  ///< builds other than the first of each topology
   int build_count() const { return builds_; }
   std::string_view backend_name() const { return backend_->name(); }
   const CheckSettings& settings() const { return settings_; }

@@ -1,0 +1,226 @@
+// The elementary decisions, written once over a predicate provider P (FilteredPredicates here;
+// CGAL's exact predicates in validators/), run by both backends and by the exact resolver.
+//
+// P provides, on vertex ids:  Sign orient3d(a, b, c, d);  Sign orient2d(a, b, c, axis);
+//                             int dominant_axis(a, b, c).
+//
+// What counts as an intersection (BRIEF.md): two triangles intersect when their closed sets
+// share a point that their shared vertices do not explain. For non-degenerate triangles F, X
+// with shared vertex set S, F and X intersect iff F n X is not contained in conv(S). Because
+// F n X is convex, that happens iff some extreme point of F n X lies outside conv(S); every
+// extreme point lies on an edge of F (inside X) or on an edge of X (inside F). So:
+//
+//   F, X intersect  <=>  some edge e of F or X meets the other triangle outside the
+//                        endpoints e shares with it (edge_hits_triangle below),
+//
+// and an edge's hit depends only on the edge and the triangle, not on which face of the edge
+// is asked: a hit of e against X means every face incident to e intersects X. That is what
+// lets each (edge, triangle) test be done once, by the edge's representative triangle.
+// (Three shared vertices, a duplicated face, is the one case outside this and is reported by
+// the caller as a touching pair.)
+#pragma once
+
+#include <cstdint>
+
+#include "snag/geom/hd.h"
+#include "snag/geom/predicates.h"
+#include "snag/geom/vec3.h"
+
+namespace snag::geom {
+
+/// A three-valued answer: uncertain when a sign the answer depends on was uncertain.
+enum class Answer : int8_t { no = 0, yes = 1, uncertain = 2 };
+
+SNAG_HD_INLINE Answer any_of(Answer a, Answer b) {
+  if (a == Answer::yes || b == Answer::yes) return Answer::yes;
+  if (a == Answer::uncertain || b == Answer::uncertain) return Answer::uncertain;
+  return Answer::no;
+}
+SNAG_HD_INLINE Answer all_of(Answer a, Answer b) {
+  if (a == Answer::no || b == Answer::no) return Answer::no;
+  if (a == Answer::uncertain || b == Answer::uncertain) return Answer::uncertain;
+  return Answer::yes;
+}
+SNAG_HD_INLINE Answer not_negative(Sign s) {
+  return s == Sign::uncertain ? Answer::uncertain : (s == Sign::negative ? Answer::no : Answer::yes);
+}
+/// s * t <= 0.
+SNAG_HD_INLINE Answer opposite_or_zero(Sign s, Sign t) {
+  if (s == Sign::zero || t == Sign::zero) return Answer::yes;
+  if (s == Sign::uncertain || t == Sign::uncertain) return Answer::uncertain;
+  return s != t ? Answer::yes : Answer::no;
+}
+/// s * t as a sign (t the orientation of a reference triangle, never zero).
+SNAG_HD_INLINE Sign times(Sign s, Sign t) {
+  if (s == Sign::uncertain || t == Sign::uncertain) return Sign::uncertain;
+  return t == Sign::negative ? negate(s) : s;
+}
+
+/// Picks the projection axis for a triangle (a, b, c) and its orientation there: the
+/// dominant axis, or the next with a nonzero exact component when the provider finds the
+/// dominant one zero (possible only for the exact provider on a triangle of tiny area).
+/// Returns Sign::uncertain when the filter cannot tell; Sign::zero only for a degenerate one.
+template <class P>
+SNAG_HD_INLINE Sign projection(const P& pred, int32_t a, int32_t b, int32_t c, int& axis) {
+  const int first = pred.dominant_axis(a, b, c);
+  for (int k = 0; k < 3; ++k) {
+    axis = (first + k) % 3;
+    const Sign s = pred.orient2d(a, b, c, axis);
+    if (s != Sign::zero) return s;
+  }
+  return Sign::zero;
+}
+
+/// Closed point-in-triangle in the projection along `axis`; `orientation` is orient2d(a, b, c).
+template <class P>
+SNAG_HD_INLINE Answer point_in_triangle_2d(const P& pred, int32_t p, int32_t a, int32_t b, int32_t c, int axis,
+                                           Sign orientation) {
+  Answer inside = not_negative(times(pred.orient2d(a, b, p, axis), orientation));
+  if (inside == Answer::no) return inside;
+  inside = all_of(inside, not_negative(times(pred.orient2d(b, c, p, axis), orientation)));
+  if (inside == Answer::no) return inside;
+  return all_of(inside, not_negative(times(pred.orient2d(c, a, p, axis), orientation)));
+}
+
+/// Do closed segments pq and xy meet, given that neither p nor q lies in the triangle one of
+/// whose edges is xy? Collinear overlap is then impossible without a vertex of the triangle
+/// strictly inside pq, and that is found as a proper crossing of the triangle's other edge
+/// through that vertex, so collinear pairs answer `no` here.
+template <class P>
+SNAG_HD_INLINE Answer segments_meet_2d(const P& pred, int32_t p, int32_t q, int32_t x, int32_t y, int axis) {
+  const Sign o1 = pred.orient2d(p, q, x, axis), o2 = pred.orient2d(p, q, y, axis);
+  if (o1 == Sign::zero && o2 == Sign::zero) return Answer::no;
+  const Answer straddles_pq = opposite_or_zero(o1, o2);
+  if (straddles_pq == Answer::no) return Answer::no;
+  const Sign o3 = pred.orient2d(x, y, p, axis), o4 = pred.orient2d(x, y, q, axis);
+  return all_of(straddles_pq, opposite_or_zero(o3, o4));
+}
+
+/// Does edge pq meet triangle t = (a, b, c) outside the endpoints it shares with t?
+/// `sp`, `sq`: the sides of p and q w.r.t. t's plane (orient3d(a, b, c, .)), zero where the
+/// endpoint is a vertex of t. Preconditions: t is not degenerate, pq is not an edge of t.
+template <class P>
+SNAG_HD Answer edge_hits_triangle(const P& pred, int32_t p, int32_t q, const Tri& t, Sign sp, Sign sq) {
+  // Both endpoints strictly on one side: no contact.
+  if ((sp == Sign::positive && sq == Sign::positive) || (sp == Sign::negative && sq == Sign::negative))
+    return Answer::no;
+  const int32_t a = t.v[0], b = t.v[1], c = t.v[2];
+  const bool p_shared = p == a || p == b || p == c;
+  const bool q_shared = q == a || q == b || q == c;
+  if (p_shared || q_shared) {
+    // One shared endpoint s: the edge leaves t's corner s. Off the plane it meets t only at s;
+    // in the plane it enters t iff its direction lies in t's closed angle at s.
+    const int32_t s = p_shared ? p : q;
+    const int32_t other = p_shared ? q : p;
+    const Sign side = p_shared ? sq : sp;
+    if (side == Sign::uncertain) return Answer::uncertain;
+    if (side != Sign::zero) return Answer::no;
+    // The corners of t after s, counterclockwise in t's own order.
+    const int32_t s_next = s == a ? b : (s == b ? c : a);
+    const int32_t s_prev = s == a ? c : (s == b ? a : b);
+    int axis = 0;
+    const Sign orientation = projection(pred, a, b, c, axis);
+    if (orientation == Sign::uncertain) return Answer::uncertain;
+    const Answer after_next = not_negative(times(pred.orient2d(s, s_next, other, axis), orientation));
+    if (after_next == Answer::no) return Answer::no;
+    return all_of(after_next, not_negative(times(pred.orient2d(s, other, s_prev, axis), orientation)));
+  }
+  if (sp == Sign::uncertain || sq == Sign::uncertain) return Answer::uncertain;
+  if (sp == Sign::zero && sq == Sign::zero) {
+    // Coplanar: the segment meets the closed triangle iff an endpoint is inside it or the
+    // segment crosses one of its edges, all in a projection that keeps the plane's incidences.
+    int axis = 0;
+    const Sign orientation = projection(pred, a, b, c, axis);
+    if (orientation == Sign::uncertain) return Answer::uncertain;
+    Answer hit = point_in_triangle_2d(pred, p, a, b, c, axis, orientation);
+    if (hit == Answer::yes) return hit;
+    hit = any_of(hit, point_in_triangle_2d(pred, q, a, b, c, axis, orientation));
+    if (hit == Answer::yes) return hit;
+    hit = any_of(hit, segments_meet_2d(pred, p, q, a, b, axis));
+    if (hit == Answer::yes) return hit;
+    hit = any_of(hit, segments_meet_2d(pred, p, q, b, c, axis));
+    if (hit == Answer::yes) return hit;
+    return any_of(hit, segments_meet_2d(pred, p, q, c, a, axis));
+  }
+  // The segment crosses or touches the plane at one point, inside the closed triangle iff the
+  // line pq passes no edge of t on the opposite side from another: the three signs below
+  // never include both a positive and a negative one.
+  const Sign e0 = pred.orient3d(p, q, a, b);
+  const Sign e1 = pred.orient3d(p, q, b, c);
+  const Sign e2 = pred.orient3d(p, q, c, a);
+  const bool has_positive = e0 == Sign::positive || e1 == Sign::positive || e2 == Sign::positive;
+  const bool has_negative = e0 == Sign::negative || e1 == Sign::negative || e2 == Sign::negative;
+  if (has_positive && has_negative) return Answer::no;
+  if (e0 == Sign::uncertain || e1 == Sign::uncertain || e2 == Sign::uncertain) return Answer::uncertain;
+  return Answer::yes;
+}
+
+/// Is triangle (a, b, c) of zero area (its corners collinear)? Exactly when its normal
+/// vanishes, i.e. its projection along every axis has orientation zero.
+template <class P>
+SNAG_HD_INLINE Answer is_degenerate(const P& pred, int32_t a, int32_t b, int32_t c) {
+  if (a == b || b == c || c == a) return Answer::yes;
+  Answer degenerate = Answer::yes;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Sign s = pred.orient2d(a, b, c, axis);
+    if (s == Sign::positive || s == Sign::negative) return Answer::no;
+    if (s == Sign::uncertain) degenerate = Answer::uncertain;
+  }
+  return degenerate;
+}
+
+/// The sides of triangle f's corners w.r.t. triangle x's plane; zero where a corner is a vertex of x.
+template <class P>
+SNAG_HD_INLINE void corner_sides(const P& pred, const Tri& f, const Tri& x, Sign side[3]) {
+  for (int i = 0; i < 3; ++i) {
+    const int32_t v = f.v[i];
+    side[i] = (v == x.v[0] || v == x.v[1] || v == x.v[2]) ? Sign::zero
+                                                          : pred.orient3d(x.v[0], x.v[1], x.v[2], v);
+  }
+}
+
+/// Index of a corner whose side is strict and no other corner's side is the same; -1 if the
+/// triangle does not straddle strictly. Sides must be certain.
+SNAG_HD_INLINE int lone_corner(const Sign side[3]) {
+  for (int i = 0; i < 3; ++i) {
+    if (side[i] == Sign::zero) continue;
+    if (side[(i + 1) % 3] != side[i] && side[(i + 2) % 3] != side[i]) return i;
+  }
+  return -1;
+}
+
+/// Whether an intersecting pair is a crossing: not coplanar, each triangle has corners strictly
+/// on both sides of the other's plane, and they share a segment of positive length.
+///
+/// With both straddling, f n plane(x) is a segment [I1, I2] of positive length with Ii on the
+/// edge from f's lone corner f0 to corner fi (or at fi, when fi lies on the plane), and
+/// likewise [J1, J2] for x from its lone corner x0. Along the line L where the planes meet,
+/// orient3d(f0, fi, x0, xj) has the sign of pos(Jj) - pos(Ii) for one direction of L (the
+/// product of the two normals, each turned towards the other triangle's lone corner): expand
+/// x0 - f0 along (fi - f0), L and (xj - x0) and use that (fi - f0).n_x < 0 and
+/// (xj - x0).n_f < 0. So the segments overlap in positive length iff some Ii < some Jj and
+/// some Jj < some Ii: among the four signs there is a positive and a negative one.
+template <class P>
+SNAG_HD Answer is_crossing(const P& pred, const Tri& f, const Tri& x) {
+  Sign sf[3], sx[3];
+  corner_sides(pred, f, x, sf);
+  corner_sides(pred, x, f, sx);
+  for (int i = 0; i < 3; ++i)
+    if (sf[i] == Sign::uncertain || sx[i] == Sign::uncertain) return Answer::uncertain;
+  const int fi = lone_corner(sf), xi = lone_corner(sx);
+  if (fi < 0 || xi < 0) return Answer::no;  // coplanar or not straddling both ways
+  const int32_t f0 = f.v[fi], f1 = f.v[(fi + 1) % 3], f2 = f.v[(fi + 2) % 3];
+  const int32_t x0 = x.v[xi], x1 = x.v[(xi + 1) % 3], x2 = x.v[(xi + 2) % 3];
+  const Sign order[4] = {pred.orient3d(f0, f1, x0, x1), pred.orient3d(f0, f1, x0, x2),
+                         pred.orient3d(f0, f2, x0, x1), pred.orient3d(f0, f2, x0, x2)};
+  bool positive = false, negative = false, uncertain = false;
+  for (Sign s : order) {
+    positive |= s == Sign::positive;
+    negative |= s == Sign::negative;
+    uncertain |= s == Sign::uncertain;
+  }
+  if (positive && negative) return Answer::yes;
+  return uncertain ? Answer::uncertain : Answer::no;
+}
+
+}  // namespace snag::geom

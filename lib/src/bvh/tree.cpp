@@ -1,0 +1,90 @@
+#include "snag/bvh/tree.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace snag::bvh {
+
+namespace {
+
+/// The internal nodes of `level`: [first, last).
+void internal_nodes_of_level(const CompleteTree& shape, int32_t level, int32_t& first, int32_t& last) {
+  first = CompleteTree::level_begin(level);
+  last = std::min(CompleteTree::level_begin(level + 1), shape.leaf_count - 1);
+}
+
+}  // namespace
+
+void Tree::build(mesh::MeshView mesh, int threads) {
+  const int32_t n = mesh.triangle_count;
+  shape_ = CompleteTree(n);
+  boxes_.assign(static_cast<size_t>(shape_.node_count()), geom::empty_box());
+  triangle_at_.resize(static_cast<size_t>(n));
+  std::iota(triangle_at_.begin(), triangle_at_.end(), 0);
+
+  // Centroids times three (the sum of the corners): the order is the same and no division.
+  std::vector<geom::Vec3d> centroid(static_cast<size_t>(n));
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int32_t t = 0; t < n; ++t) {
+    const geom::Tri tri = mesh.triangles[t];
+    centroid[t] = mesh.positions[tri.v[0]] + mesh.positions[tri.v[1]] + mesh.positions[tri.v[2]];
+  }
+
+  // Level by level: the segments of one level are disjoint ranges of triangle_at_.
+  for (int32_t level = 0; level < shape_.depth; ++level) {
+    int32_t first, last;
+    internal_nodes_of_level(shape_, level, first, last);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) if (last - first > 1)
+    for (int32_t node = first; node < last; ++node) {
+      int32_t begin, end, left_begin, split;
+      shape_.positions_under(node, begin, end);
+      shape_.positions_under(2 * node + 1, left_begin, split);
+      double lo[3] = {centroid[triangle_at_[begin]].x, centroid[triangle_at_[begin]].y,
+                      centroid[triangle_at_[begin]].z};
+      double hi[3] = {lo[0], lo[1], lo[2]};
+      for (int32_t p = begin + 1; p < end; ++p) {
+        const geom::Vec3d c = centroid[triangle_at_[p]];
+        lo[0] = std::min(lo[0], c.x), hi[0] = std::max(hi[0], c.x);
+        lo[1] = std::min(lo[1], c.y), hi[1] = std::max(hi[1], c.y);
+        lo[2] = std::min(lo[2], c.z), hi[2] = std::max(hi[2], c.z);
+      }
+      const double extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+      const int axis = (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
+      auto* data = triangle_at_.data();
+      std::nth_element(data + begin, data + split, data + end, [&](int32_t a, int32_t b) {
+        const double ca = geom::coord(centroid[a], axis), cb = geom::coord(centroid[b], axis);
+        return ca < cb || (ca == cb && a < b);
+      });
+    }
+  }
+  refit(mesh, threads);
+}
+
+void Tree::refit(mesh::MeshView mesh, int threads) {
+  TreeView tree = view();
+  const int32_t n = shape_.leaf_count;
+#pragma omp parallel num_threads(threads)
+  {
+#pragma omp for schedule(static)
+    for (int32_t leaf = n - 1; leaf < 2 * n - 1; ++leaf) refit_leaf(leaf, tree, mesh);
+    // One level at a time from the deepest internal level up; the implicit barrier after
+    // each loop orders a level's writes before its parents read them.
+    for (int32_t level = shape_.depth - 1; level >= 0; --level) {
+      int32_t first, last;
+      internal_nodes_of_level(shape_, level, first, last);
+#pragma omp for schedule(static)
+      for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
+    }
+  }
+}
+
+double Tree::quality() const {
+  const int32_t internal = shape_.leaf_count - 1;
+  if (internal <= 0) return 0.0;
+  double sum = 0.0;
+  for (int32_t node = 0; node < internal; ++node) sum += geom::half_area(boxes_[node]);
+  const double root = geom::half_area(boxes_[0]);
+  return root > 0.0 ? sum / root : 0.0;
+}
+
+}  // namespace snag::bvh

@@ -1,0 +1,90 @@
+#include "snag/detect/topology.h"
+
+#include <algorithm>
+
+#include "snag/error.h"
+
+namespace snag::detect {
+
+namespace {
+
+struct EdgeRecord {
+  int32_t u, v;      // endpoints, u < v
+  int32_t triangle;
+  int32_t corner;    // the triangle's edge k joins corners k and k + 1
+};
+
+}  // namespace
+
+Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_count) {
+  Topology topo;
+  topo.triangles.assign(triangles.begin(), triangles.end());
+  topo.vertex_count = vertex_count;
+  const auto n = static_cast<int32_t>(triangles.size());
+  topo.triangle_edges.assign(static_cast<size_t>(n), {-1, -1, -1});
+  topo.owned_edges.assign(static_cast<size_t>(n), 0);
+
+  std::vector<EdgeRecord> records;
+  records.reserve(static_cast<size_t>(n) * 3);
+  for (int32_t t = 0; t < n; ++t) {
+    const geom::Tri& tri = triangles[t];
+    for (int k = 0; k < 3; ++k)
+      if (tri.v[k] < 0 || tri.v[k] >= vertex_count)
+        throw InternalError("triangle " + std::to_string(t) + " uses vertex " + std::to_string(tri.v[k]) +
+                            " of " + std::to_string(vertex_count));
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0]) {
+      // A repeated corner: zero area in every frame, left out of the search, owns nothing.
+      topo.index_degenerate.push_back(t);
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = tri.v[k], b = tri.v[(k + 1) % 3];
+      records.push_back({std::min(a, b), std::max(a, b), t, k});
+    }
+  }
+  std::sort(records.begin(), records.end(), [](const EdgeRecord& x, const EdgeRecord& y) {
+    if (x.u != y.u) return x.u < y.u;
+    if (x.v != y.v) return x.v < y.v;
+    return x.triangle < y.triangle;
+  });
+
+  topo.edge_face_offsets.push_back(0);
+  for (size_t r = 0; r < records.size(); ++r) {
+    const EdgeRecord& rec = records[r];
+    const bool new_edge = r == 0 || rec.u != records[r - 1].u || rec.v != records[r - 1].v;
+    if (new_edge) {
+      if (r > 0) topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
+      topo.edges.push_back({rec.u, rec.v});
+      // Records of one edge are sorted by triangle: the first is the representative.
+      topo.owned_edges[rec.triangle] |= static_cast<uint8_t>(1u << rec.corner);
+    }
+    const auto edge = static_cast<int32_t>(topo.edges.size() - 1);
+    topo.triangle_edges[rec.triangle][rec.corner] = edge;
+    topo.edge_faces.push_back(rec.triangle);
+  }
+  if (!records.empty()) topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
+  return topo;
+}
+
+std::vector<uint8_t> ownership_without(const Topology& topo, std::span<const int32_t> degenerate) {
+  std::vector<uint8_t> owned = topo.owned_edges;
+  if (degenerate.empty()) return owned;
+  auto is_degenerate = [&](int32_t t) { return std::binary_search(degenerate.begin(), degenerate.end(), t); };
+  for (int32_t d : degenerate) {
+    for (int k = 0; k < 3; ++k) {
+      if (!(owned[d] & (1u << k))) continue;
+      owned[d] &= static_cast<uint8_t>(~(1u << k));
+      const int32_t edge = topo.triangle_edges[d][k];
+      for (int32_t i = topo.edge_face_offsets[edge]; i < topo.edge_face_offsets[edge + 1]; ++i) {
+        const int32_t f = topo.edge_faces[i];
+        if (f == d || is_degenerate(f)) continue;
+        for (int kk = 0; kk < 3; ++kk)
+          if (topo.triangle_edges[f][kk] == edge) owned[f] |= static_cast<uint8_t>(1u << kk);
+        break;
+      }
+    }
+  }
+  return owned;
+}
+
+}  // namespace snag::detect

@@ -1,0 +1,28 @@
+// CGAL's own answer, for tests and benchmarks: Polygon_mesh_processing::self_intersections on
+// the triangles as one mesh (Epick kernel), and its exact per-pair tests.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "snag/geom/vec3.h"
+
+namespace snag::validators {
+
+/// Intersecting triangle pairs (a < b, sorted) as CGAL's self_intersections reports them, with
+/// the triangles' shared vertices taken from their ids. Zero-area triangles are left out
+/// (snag reports them apart). Throws snag::InternalError when the triangles do not form a
+/// mesh CGAL's halfedge structure can hold; then use `cgal_soup_self_intersections`.
+std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
+                                                                 std::span<const geom::Tri> triangles);
+
+/// The same rules (shared edge: coplanar and folded onto each other; shared vertex: the
+/// opposite edge of one meets the other; else CGAL::do_intersect) decided pair by pair with
+/// CGAL's predicates over CGAL's box intersection, with shared vertices taken from ids. Works
+/// on any triangle soup, including non-manifold ones.
+std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(std::span<const geom::Vec3d> positions,
+                                                                      std::span<const geom::Tri> triangles);
+
+}  // namespace snag::validators

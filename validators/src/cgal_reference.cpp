@@ -1,0 +1,115 @@
+#include "snag/validators/cgal_reference.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
+
+#include <algorithm>
+#include <string>
+
+#include "snag/error.h"
+
+namespace snag::validators {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+
+Point point_of(const geom::Vec3d& p) { return {p.x, p.y, p.z}; }
+
+bool degenerate(std::span<const geom::Vec3d> positions, const geom::Tri& t) {
+  return CGAL::collinear(point_of(positions[t.v[0]]), point_of(positions[t.v[1]]), point_of(positions[t.v[2]]));
+}
+
+void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
+  for (auto& [a, b] : pairs)
+    if (a > b) std::swap(a, b);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
+/// CGAL's do_faces_intersect rules (Polygon_mesh_processing/self_intersections.h), with the
+/// shared vertices of two faces taken from their ids instead of halfedge adjacency.
+bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f, const geom::Tri& g) {
+  int shared = 0, fi = -1, gi = -1;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (f.v[i] == g.v[j]) {
+        if (shared == 0) fi = i, gi = j;
+        ++shared;
+      }
+  auto P = [&](int32_t v) { return point_of(positions[v]); };
+  if (shared == 3) return true;  // a duplicated face overlaps beyond each of its edges
+  if (shared == 2) {
+    // The faces' third vertices; the shared edge is the other two.
+    int f_third = 0, g_third = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (f.v[i] != g.v[0] && f.v[i] != g.v[1] && f.v[i] != g.v[2]) f_third = i;
+      if (g.v[i] != f.v[0] && g.v[i] != f.v[1] && g.v[i] != f.v[2]) g_third = i;
+    }
+    const Point p = P(f.v[(f_third + 1) % 3]), q = P(f.v[(f_third + 2) % 3]);
+    const Point r = P(f.v[f_third]), s = P(g.v[g_third]);
+    return CGAL::coplanar(p, q, r, s) && CGAL::coplanar_orientation(p, q, r, s) == CGAL::POSITIVE;
+  }
+  const Kernel::Triangle_3 tf(P(f.v[0]), P(f.v[1]), P(f.v[2])), tg(P(g.v[0]), P(g.v[1]), P(g.v[2]));
+  if (shared == 1) {
+    const Kernel::Segment_3 sf(P(f.v[(fi + 1) % 3]), P(f.v[(fi + 2) % 3]));
+    const Kernel::Segment_3 sg(P(g.v[(gi + 1) % 3]), P(g.v[(gi + 2) % 3]));
+    return CGAL::do_intersect(tf, sg) || CGAL::do_intersect(tg, sf);
+  }
+  return CGAL::do_intersect(tf, tg);
+}
+
+}  // namespace
+
+std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
+                                                                 std::span<const geom::Tri> triangles) {
+  Mesh mesh;
+  for (const geom::Vec3d& p : positions) mesh.add_vertex(point_of(p));
+  std::vector<int32_t> triangle_of_face;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const geom::Tri& tri = triangles[t];
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] || degenerate(positions, tri)) continue;
+    const auto face = mesh.add_face(Mesh::Vertex_index(tri.v[0]), Mesh::Vertex_index(tri.v[1]),
+                                    Mesh::Vertex_index(tri.v[2]));
+    if (face == Mesh::null_face())
+      throw InternalError("triangle " + std::to_string(t) + " cannot join CGAL's halfedge mesh (non-manifold or "
+                          "inconsistently oriented)");
+    triangle_of_face.push_back(static_cast<int32_t>(t));
+  }
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
+  CGAL::Polygon_mesh_processing::self_intersections<CGAL::Parallel_if_available_tag>(mesh, std::back_inserter(found));
+  std::vector<std::pair<int32_t, int32_t>> pairs;
+  pairs.reserve(found.size());
+  for (const auto& [f, g] : found) pairs.emplace_back(triangle_of_face[f.idx()], triangle_of_face[g.idx()]);
+  sort_pairs(pairs);
+  return pairs;
+}
+
+std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(std::span<const geom::Vec3d> positions,
+                                                                      std::span<const geom::Tri> triangles) {
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+  std::vector<Box> boxes;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const geom::Tri& tri = triangles[t];
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] || degenerate(positions, tri)) continue;
+    const auto box = point_of(positions[tri.v[0]]).bbox() + point_of(positions[tri.v[1]]).bbox() +
+                     point_of(positions[tri.v[2]]).bbox();
+    boxes.emplace_back(box, static_cast<int32_t>(t));
+  }
+  std::vector<const Box*> pointers;
+  for (const Box& b : boxes) pointers.push_back(&b);
+  std::vector<std::pair<int32_t, int32_t>> pairs;
+  CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
+      pointers.begin(), pointers.end(), [&](const Box* a, const Box* b) {
+        if (faces_intersect(positions, triangles[a->info()], triangles[b->info()]))
+          pairs.emplace_back(a->info(), b->info());
+      });
+  sort_pairs(pairs);
+  return pairs;
+}
+
+}  // namespace snag::validators
