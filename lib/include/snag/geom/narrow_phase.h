@@ -179,12 +179,15 @@ SNAG_HD_INLINE void corner_sides(const P& pred, const Tri& f, const Tri& x, Sign
   }
 }
 
-/// Index of a corner whose side is strict and no other corner's side is the same; -1 if the
-/// triangle does not straddle strictly. Sides must be certain.
+/// Index of a corner alone on its strict side: no other corner on that side and at least one
+/// strictly on the other. -1 when the triangle does not have corners strictly on both sides.
+/// Sides must be certain.
 SNAG_HD_INLINE int lone_corner(const Sign side[3]) {
   for (int i = 0; i < 3; ++i) {
     if (side[i] == Sign::zero) continue;
-    if (side[(i + 1) % 3] != side[i] && side[(i + 2) % 3] != side[i]) return i;
+    const Sign next = side[(i + 1) % 3], prev = side[(i + 2) % 3];
+    const Sign opposite = negate(side[i]);
+    if (next != side[i] && prev != side[i] && (next == opposite || prev == opposite)) return i;
   }
   return -1;
 }

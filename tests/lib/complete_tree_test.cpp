@@ -1,0 +1,166 @@
+// The implicit complete tree: index arithmetic for every n, build, refit and traversal
+// against brute force.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "snag/bvh/complete_tree.h"
+#include "snag/bvh/tree.h"
+
+namespace snag::bvh {
+namespace {
+
+TEST(CompleteTree, LeafPositionMappingAndRangesForEveryNUpTo5000) {
+  for (int32_t n = 1; n <= 5000; ++n) {
+    const CompleteTree shape(n);
+    ASSERT_EQ(shape.node_count(), 2 * n - 1);
+    std::vector<int32_t> leaf_seen(static_cast<size_t>(2 * n - 1), 0);
+    for (int32_t p = 0; p < n; ++p) {
+      const int32_t leaf = shape.leaf_at(p);
+      ASSERT_TRUE(shape.is_leaf(leaf)) << "n=" << n << " p=" << p;
+      ASSERT_LT(leaf, 2 * n - 1);
+      ASSERT_EQ(shape.position_of(leaf), p) << "n=" << n;
+      ASSERT_EQ(leaf_seen[leaf]++, 0) << "two positions on leaf " << leaf << ", n=" << n;
+      int32_t begin, end;
+      shape.positions_under(leaf, begin, end);
+      ASSERT_EQ(begin, p);
+      ASSERT_EQ(end, p + 1);
+      if (p > 0) {  // left-to-right order: a leaf's in-order successor is the next position
+        ASSERT_LT(shape.position_of(shape.leaf_at(p - 1)), p);
+      }
+    }
+    int32_t begin, end;
+    shape.positions_under(0, begin, end);
+    ASSERT_EQ(begin, 0);
+    ASSERT_EQ(end, n);
+    for (int32_t node = 0; node < n - 1; ++node) {  // internal nodes: children partition the range
+      int32_t lb, le, rb, re;
+      shape.positions_under(node, begin, end);
+      shape.positions_under(2 * node + 1, lb, le);
+      shape.positions_under(2 * node + 2, rb, re);
+      ASSERT_EQ(lb, begin) << "n=" << n << " node=" << node;
+      ASSERT_EQ(le, rb) << "n=" << n << " node=" << node;
+      ASSERT_EQ(re, end) << "n=" << n << " node=" << node;
+      ASSERT_LT(lb, le);
+      ASSERT_LT(rb, re);
+    }
+    // Leaves are exactly the nodes n - 1 .. 2n - 2; the deepest level's leaves come first.
+    for (int32_t node = n - 1; node < 2 * n - 1; ++node) ASSERT_EQ(leaf_seen[node], 1);
+    if (n > 1) ASSERT_EQ(CompleteTree::level_of(shape.leaf_at(0)), shape.depth);
+  }
+}
+
+struct Soup {
+  std::vector<geom::Vec3d> positions;
+  std::vector<geom::Tri> triangles;
+  mesh::MeshView view() const { return mesh::view_of(positions, triangles); }
+};
+
+Soup random_soup(int32_t count, uint32_t seed, double size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> where(0.0, 10.0), offset(-size, size);
+  Soup soup;
+  for (int32_t t = 0; t < count; ++t) {
+    const geom::Vec3d c{where(rng), where(rng), where(rng)};
+    for (int k = 0; k < 3; ++k) soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
+    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+  }
+  return soup;
+}
+
+void expect_boxes_nest(const Tree& tree, const Soup& soup) {
+  const auto& boxes = tree.boxes();
+  const CompleteTree& shape = tree.shape();
+  for (int32_t node = 0; node < shape.leaf_count - 1; ++node) {
+    ASSERT_TRUE(geom::contains(boxes[node], boxes[2 * node + 1])) << "node " << node;
+    ASSERT_TRUE(geom::contains(boxes[node], boxes[2 * node + 2])) << "node " << node;
+  }
+  for (int32_t p = 0; p < shape.leaf_count; ++p) {
+    const geom::Box3f& box = boxes[shape.leaf_at(p)];
+    const geom::Tri t = soup.triangles[tree.triangle_at()[p]];
+    for (int k = 0; k < 3; ++k) {
+      const geom::Vec3d v = soup.positions[t.v[k]];
+      ASSERT_TRUE(box.lo[0] <= v.x && v.x <= box.hi[0] && box.lo[1] <= v.y && v.y <= box.hi[1] &&
+                  box.lo[2] <= v.z && v.z <= box.hi[2]);
+    }
+  }
+}
+
+TEST(Tree, EveryTriangleInExactlyOneLeafAndBoxesNestAfterBuildAndRefit) {
+  for (int32_t n : {1, 2, 3, 5, 17, 64, 100, 1000, 4097}) {
+    const uint32_t seed = 1000 + static_cast<uint32_t>(n);
+    SCOPED_TRACE("n=" + std::to_string(n) + " seed=" + std::to_string(seed));
+    Soup soup = random_soup(n, seed, 0.3);
+    Tree tree;
+    tree.build(soup.view(), 2);
+    std::vector<int32_t> sorted = tree.triangle_at();
+    std::sort(sorted.begin(), sorted.end());
+    for (int32_t t = 0; t < n; ++t) ASSERT_EQ(sorted[t], t);
+    expect_boxes_nest(tree, soup);
+    // Deform and refit: boxes must follow the new positions.
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> move(-1.0, 1.0);
+    for (auto& p : soup.positions) p = p + geom::Vec3d{move(rng), move(rng), move(rng)};
+    tree.refit(soup.view(), 2);
+    expect_boxes_nest(tree, soup);
+  }
+}
+
+TEST(Tree, BuildIsTheSameForEveryThreadCount) {
+  Soup soup = random_soup(3000, 7, 0.2);
+  Tree one, two, four;
+  one.build(soup.view(), 1);
+  two.build(soup.view(), 2);
+  four.build(soup.view(), 4);
+  EXPECT_EQ(one.triangle_at(), two.triangle_at());
+  EXPECT_EQ(one.triangle_at(), four.triangle_at());
+}
+
+TEST(Tree, BuildSplitsEachSegmentAlongTheLongestAxis) {
+  // Triangles strung along x: sorted order along x must be recovered exactly.
+  Soup soup;
+  const int32_t n = 777;
+  for (int32_t t = 0; t < n; ++t) {
+    const double x = static_cast<double>((t * 389) % n);  // a permutation of 0..n-1
+    soup.positions.push_back({x, 0, 0});
+    soup.positions.push_back({x + 0.5, 0.1, 0});
+    soup.positions.push_back({x, 0.1, 0.1});
+    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+  }
+  Tree tree;
+  tree.build(soup.view(), 2);
+  for (int32_t p = 1; p < n; ++p)
+    ASSERT_LT(soup.positions[3 * tree.triangle_at()[p - 1]].x, soup.positions[3 * tree.triangle_at()[p]].x);
+}
+
+TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
+  for (int32_t n : {1, 2, 3, 9, 50, 513, 2000}) {
+    for (double size : {0.2, 1.0, 4.0}) {
+      const uint32_t seed = static_cast<uint32_t>(n * 31 + size * 7);
+      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) + " seed=" + std::to_string(seed));
+      Soup soup = random_soup(n, seed, size);
+      Tree tree;
+      tree.build(soup.view(), 2);
+      const TreeView view = tree.view();
+      std::multiset<std::pair<int32_t, int32_t>> visited;
+      for (int32_t p = 0; p < n; ++p) {
+        const int32_t t = view.triangle_at[p];
+        for_each_later_overlap(view, p, [&](int32_t x) { visited.insert({std::min(t, x), std::max(t, x)}); });
+      }
+      std::multiset<std::pair<int32_t, int32_t>> expected;
+      for (int32_t a = 0; a < n; ++a)
+        for (int32_t b = a + 1; b < n; ++b) {
+          const geom::Tri ta = soup.triangles[a], tb = soup.triangles[b];
+          const geom::Box3f boxa = geom::triangle_box(soup.positions[ta.v[0]], soup.positions[ta.v[1]], soup.positions[ta.v[2]]);
+          const geom::Box3f boxb = geom::triangle_box(soup.positions[tb.v[0]], soup.positions[tb.v[1]], soup.positions[tb.v[2]]);
+          if (geom::overlap(boxa, boxb)) expected.insert({a, b});
+        }
+      ASSERT_EQ(visited, expected);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace snag::bvh
