@@ -19,13 +19,14 @@ int main(int argc, char** argv) {
   try {
     app.set_version_flag("--version", SNAG_VERSION);
     app.require_subcommand(1, 1);
-    app.footer(
-        "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
-        "3 input or output error, 4 internal error. See snag(1).");
     snag::cli::CheckOptions check;
     CLI::App* check_command = snag::cli::add_check_command(app, check);
     snag::cli::BenchOptions bench;
     CLI::App* bench_cpu_command = snag::cli::add_bench_command(app, bench);
+    // Set after the subcommands are added, so that they do not inherit it.
+    app.footer(
+        "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
+        "3 input or output error, 4 internal error. See snag(1).");
 
     app.parse(argc, argv);
     if (check_command->parsed()) return snag::cli::run_check(check);

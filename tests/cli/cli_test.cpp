@@ -1,0 +1,292 @@
+// The `snag` executable end to end: hand-built sequences with exact expected reports, exit
+// statuses 0 to 3, no report left by a failed run, and --help against the man page.
+#include <algorithm>
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/run_snag.h"
+#include "test_paths.h"
+
+namespace snag::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A quad (polygon 0: triangles (0,1,2) and (0,2,3) in the z = 0 plane) and a triangle B
+/// (polygon 1) standing across the quad's second triangle: exactly one crossing pair. The quad's
+/// two triangles share an edge and lie flat, side by side: not a pair.
+constexpr const char* quad_vertices =
+    "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\n";
+constexpr const char* b_crossing = "v 1 3 -1\nv 1 3 1\nv 0.6 3.3 0\n";
+constexpr const char* b_away = "v 11 3 -1\nv 11 3 1\nv 10.6 3.3 0\n";
+
+/// Frame 1: quad then B. Frame 2: the face list reordered (B first): a topology change, the
+/// pair is now (0, 2). Frame 3: same faces as frame 2, B moved away: clean.
+fs::path write_hand_built_sequence(const fs::path& dir) {
+  fs::create_directories(dir);
+  write_text(dir / "f.0001.obj", std::string("# frame 1\n") + quad_vertices + b_crossing +
+                                     "f 1 2 3 4\nf 5 6 7\n");
+  write_text(dir / "f.0002.obj", std::string(quad_vertices) + b_crossing + "f 5 6 7\nf 1 2 3 4\n");
+  write_text(dir / "f.0003.obj", std::string(quad_vertices) + b_away + "f 5 6 7\nf 1 2 3 4\n");
+  return dir;
+}
+
+std::string without_column(const std::string& csv, const std::string& column) {
+  const auto rows = parse_csv(csv);
+  if (rows.empty()) return {};
+  const auto it = std::find(rows[0].begin(), rows[0].end(), column);
+  const size_t skip = it == rows[0].end() ? rows[0].size() : static_cast<size_t>(it - rows[0].begin());
+  std::string out;
+  for (const auto& row : rows) {
+    bool first = true;
+    for (size_t i = 0; i < row.size(); ++i) {
+      if (i == skip) continue;
+      out += (first ? "" : ",") + row[i];
+      first = false;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string context(const RunResult& r) { return "stdout:\n" + r.out + "\nstderr:\n" + r.err; }
+
+TEST(CliCheck, HandBuiltSequenceReports) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult r = run_snag({"check", "seq", "--out", "out", "--rebuild", "never"}, tmp.path());
+  ASSERT_EQ(r.status, 1) << context(r);
+
+  EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"),
+            "frame,face_a,face_b,kind,poly_a,poly_b\n"
+            "1,1,2,crossing,0,1\n"
+            "2,0,2,crossing,0,1\n");
+  EXPECT_EQ(without_column(read_text(tmp.path() / "out" / "frames.csv"), "seconds"),
+            "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,rebuilt,"
+            "topology_changed\n"
+            "1,seq/f.0001.obj,3,1,1,0,0,0,1,0\n"
+            "2,seq/f.0002.obj,3,1,1,0,0,0,1,1\n"
+            "3,seq/f.0003.obj,3,0,0,0,0,0,0,0\n");
+
+  const auto j = nlohmann::json::parse(read_text(tmp.path() / "out" / "report.json"));
+  EXPECT_EQ(j.at("schema"), "snag-report/1");
+  EXPECT_EQ(j.at("settings").at("backend"), "cpu");
+  EXPECT_EQ(j.at("settings").at("rebuild"), "never");
+  EXPECT_EQ(j.at("settings").at("fail_on"), "crossing");
+  EXPECT_TRUE(j.at("settings").at("weld").is_null());
+  EXPECT_EQ(j.at("inputs").at("sequence"), "seq");
+  EXPECT_EQ(j.at("inputs").at("ids"), "file");
+  EXPECT_EQ(j.at("inputs").at("files"),
+            (nlohmann::json{"seq/f.0001.obj", "seq/f.0002.obj", "seq/f.0003.obj"}));
+  ASSERT_EQ(j.at("frames").size(), 3u);
+  EXPECT_EQ(j.at("frames").at(0).at("pairs"),
+            (nlohmann::json::array(
+                {{{"a", 1}, {"b", 2}, {"kind", "crossing"}, {"poly_a", 0}, {"poly_b", 1}}})));
+  EXPECT_EQ(j.at("frames").at(0).at("polygons"), 2);
+  EXPECT_EQ(j.at("frames").at(1).at("topology_changed"), true);
+  EXPECT_EQ(j.at("frames").at(2).at("topology_changed"), false);
+  const auto& s = j.at("summary");
+  EXPECT_EQ(s.at("frames_checked"), 3);
+  EXPECT_EQ(s.at("frames_with_crossings"), 2);
+  EXPECT_EQ(s.at("worst_frame").at("frame"), 1);
+  EXPECT_EQ(s.at("pairs"), 2);
+  EXPECT_EQ(s.at("topology_changes"), 1);
+  EXPECT_EQ(s.at("builds"), 2);
+  EXPECT_EQ(s.at("rebuilds"), 0);
+  EXPECT_EQ(s.at("failed"), true);
+
+  // The human summary ends standard output.
+  EXPECT_NE(r.out.find("frames checked       3\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("frames with crossing 2\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("worst frame          1 (seq/f.0001.obj): 1 crossing, 0 touching\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("1 topology change\n"), std::string::npos) << r.out;
+}
+
+TEST(CliCheck, CleanSelectionExitsZero) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult r = run_snag({"check", "seq", "--frames", "3", "--out", "out"}, tmp.path());
+  EXPECT_EQ(r.status, 0) << context(r);
+  EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), "frame,face_a,face_b,kind,poly_a,poly_b\n");
+  EXPECT_NE(r.out.find("frames checked       1\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("worst frame          none\n"), std::string::npos) << r.out;
+}
+
+TEST(CliCheck, FailOnDecidesTheStatus) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  EXPECT_EQ(run_snag({"check", "seq", "--fail-on", "none", "-q"}, tmp.path()).status, 0);
+  EXPECT_EQ(run_snag({"check", "seq", "--fail-on", "any", "-q"}, tmp.path()).status, 1);
+  const RunResult quiet = run_snag({"check", "seq", "--quiet"}, tmp.path());
+  EXPECT_EQ(quiet.status, 1);
+  EXPECT_EQ(quiet.err, "") << "--quiet prints nothing on standard error";
+}
+
+TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult r = run_snag({"check", "seq"}, tmp.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << "no bar when standard error is a file";
+  EXPECT_NE(r.err.find("[3/3] frame 3: clean"), std::string::npos) << r.err;
+}
+
+TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
+  // Two flat triangles side by side along their hypotenuse, each with its own copy of the seam's
+  // two vertices (an unwelded seam): as separate vertices they touch along the seam; welded,
+  // they share the edge and do not intersect.
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "seam");
+  write_text(tmp.path() / "seam" / "s.1.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 4 6 5\n");
+  const RunResult plain = run_snag({"check", "seam", "--fail-on", "none", "--out", "a"}, tmp.path());
+  EXPECT_EQ(plain.status, 0) << context(plain);
+  EXPECT_NE(plain.err.find("2 vertices coincide exactly"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("--weld"), std::string::npos) << plain.err;
+  EXPECT_EQ(read_text(tmp.path() / "a" / "pairs.csv"),
+            "frame,face_a,face_b,kind,poly_a,poly_b\n1,0,1,touching,0,1\n");
+  const auto a = nlohmann::json::parse(read_text(tmp.path() / "a" / "report.json"));
+  EXPECT_EQ(a.at("inputs").at("coincident_vertices"), 2);
+
+  const RunResult welded = run_snag({"check", "seam", "--weld", "1e-6", "--fail-on", "any", "--out", "b"},
+                                    tmp.path());
+  EXPECT_EQ(welded.status, 0) << context(welded);
+  EXPECT_EQ(welded.err.find("coincide"), std::string::npos) << welded.err;
+  EXPECT_EQ(read_text(tmp.path() / "b" / "pairs.csv"), "frame,face_a,face_b,kind,poly_a,poly_b\n");
+  const auto b = nlohmann::json::parse(read_text(tmp.path() / "b" / "report.json"));
+  EXPECT_EQ(b.at("inputs").at("welded_vertices"), 2);
+  EXPECT_DOUBLE_EQ(b.at("settings").at("weld").get<double>(), 1e-6);
+}
+
+TEST(CliStatus, UsageErrorsExitTwo) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const std::vector<std::vector<std::string>> cases = {
+      {},
+      {"frobnicate"},
+      {"check"},
+      {"check", "seq", "--bogus"},
+      {"check", "seq", "--rebuild", "sometimes"},
+      {"check", "seq", "--fail-on", "all"},
+      {"check", "seq", "--backend", "gpu"},
+      {"check", "seq", "--threads", "-1"},
+      {"check", "seq", "--weld", "-0.5"},
+      {"check", "seq", "--frames", "abc"},
+      {"check", "seq", "--frames", "100-200"},
+      {"bench"},
+  };
+  for (const auto& args : cases) {
+    std::string line;
+    for (const auto& a : args) line += " " + a;
+    const RunResult r = run_snag(args, tmp.path());
+    EXPECT_EQ(r.status, 2) << "snag" << line << "\n" << context(r);
+    EXPECT_FALSE(r.err.empty()) << "snag" << line << " says nothing";
+  }
+}
+
+TEST(CliStatus, CudaBackendIsAClearUsageError) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult r = run_snag({"check", "seq", "--backend", "cuda"}, tmp.path());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("CUDA backend is not built"), std::string::npos) << r.err;
+}
+
+TEST(CliStatus, HelpAndVersionExitZero) {
+  TempDir tmp;
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--help"}, {"check", "--help"}, {"bench", "cpu", "--help"}, {"--version"}}) {
+    const RunResult r = run_snag(args, tmp.path());
+    EXPECT_EQ(r.status, 0) << args[0] << "\n" << context(r);
+    EXPECT_FALSE(r.out.empty());
+  }
+}
+
+TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  // A frame after two good ones: the error is found late, and still no report appears.
+  write_text(tmp.path() / "seq" / "f.0004.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n");
+  const RunResult r = run_snag({"check", "seq", "--out", "out"}, tmp.path());
+  EXPECT_EQ(r.status, 3) << context(r);
+  EXPECT_NE(r.err.find("f.0004.obj:3"), std::string::npos) << r.err;
+  if (fs::exists(tmp.path() / "out")) EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
+}
+
+TEST(CliStatus, VertexCountChangeExitsThree) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  write_text(tmp.path() / "seq" / "f.0004.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const RunResult r = run_snag({"check", "seq", "--out", "out"}, tmp.path());
+  EXPECT_EQ(r.status, 3) << context(r);
+  EXPECT_NE(r.err.find("f.0004.obj"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 vertices"), std::string::npos) << r.err;
+  if (fs::exists(tmp.path() / "out")) EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
+}
+
+TEST(CliStatus, MissingSequenceAndUnwritableOutExitThree) {
+  TempDir tmp;
+  EXPECT_EQ(run_snag({"check", "nowhere/f.%04d.obj"}, tmp.path()).status, 3);
+  write_hand_built_sequence(tmp.path() / "seq");
+  write_text(tmp.path() / "a-file", "x");
+  const RunResult r = run_snag({"check", "seq", "--out", "a-file"}, tmp.path());
+  EXPECT_EQ(r.status, 3) << context(r);
+  EXPECT_NE(r.err.find("not a directory"), std::string::npos) << r.err;
+  EXPECT_EQ(read_text(tmp.path() / "a-file"), "x");
+}
+
+/// Long and short options named in `text`: "--word" and " -x".
+std::set<std::string> options_in(const std::string& text) {
+  std::set<std::string> found;
+  const std::regex option(R"((^|[\s,\[])(--[a-z][a-z-]*|-[a-zA-Z])\b)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), option); it != std::sregex_iterator(); ++it)
+    found.insert((*it)[2]);
+  return found;
+}
+
+/// The man page's section for one command (`.SS "snag check` up to the next .SS or .SH),
+/// with roff's escaped hyphens made plain.
+std::string man_section(const std::string& man, const std::string& heading) {
+  const size_t start = man.find(".SS \"" + heading);
+  if (start == std::string::npos) return {};
+  size_t end = man.find("\n.S", start + 1);
+  std::string section = man.substr(start, end == std::string::npos ? std::string::npos : end - start);
+  return std::regex_replace(section, std::regex(R"(\\-)"), "-");
+}
+
+TEST(CliHelp, AgreesWithTheManPage) {
+  const std::string man = read_text(source_dir() / "man" / "snag.1");
+  TempDir tmp;
+  const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
+      {"snag check", {"check", "--help"}},
+      {"snag bench cpu", {"bench", "cpu", "--help"}},
+  };
+  for (const auto& [heading, args] : commands) {
+    const std::string section = man_section(man, heading);
+    ASSERT_FALSE(section.empty()) << "man/snag.1 has no .SS \"" << heading << "\" section";
+    const RunResult help = run_snag(args, tmp.path());
+    ASSERT_EQ(help.status, 0);
+    std::set<std::string> in_help = options_in(help.out);
+    in_help.erase("-h");
+    in_help.erase("--help");
+    std::set<std::string> in_man = options_in(section);
+    in_man.erase("-h");
+    in_man.erase("--help");
+    EXPECT_EQ(in_help, in_man) << heading << ": `snag " << args[0] << " --help` and man/snag.1 list "
+                               << "different options";
+  }
+  // Every exit status in the man page.
+  for (const char* status : {".B 0", ".B 1", ".B 2", ".B 3", ".B 4"})
+    EXPECT_NE(man.find(std::string(".TP\n") + status), std::string::npos) << status;
+}
+
+}  // namespace
+}  // namespace snag::test

@@ -1,0 +1,45 @@
+// Running the built `snag` in a child process, and small file helpers for the CLI tests.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace snag::test {
+
+/// $SNAG_EXECUTABLE, else the executable CMake built.
+std::filesystem::path snag_executable();
+
+struct RunResult {
+  int status = -1;  ///< exit status; 128 + signal when killed by one
+  std::string out;  ///< standard output
+  std::string err;  ///< standard error
+};
+
+/// Runs snag with `args` in working directory `cwd`, standard input closed, and waits for it.
+RunResult run_snag(const std::vector<std::string>& args, const std::filesystem::path& cwd);
+
+/// A fresh directory under the system temporary directory, removed with its contents.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+std::string read_text(const std::filesystem::path& path);
+void write_text(const std::filesystem::path& path, const std::string& text);
+
+/// Rows of a CSV file without quoted fields (what snag writes for these samples), split on
+/// commas; the header is row 0.
+std::vector<std::vector<std::string>> parse_csv(const std::string& text);
+
+/// Names in `dir`, sorted.
+std::vector<std::string> directory_entries(const std::filesystem::path& dir);
+
+}  // namespace snag::test
