@@ -1,0 +1,263 @@
+// OBJ parsing from one in-memory buffer: one pass, no per-line allocation, numbers through
+// fast_float and std::from_chars. Only `v`, `f`, `o` and `g` are looked at; every other line
+// costs one memchr to find its end.
+#include "snag/io/obj_reader.h"
+
+#include <fast_float/fast_float.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include "file_buffer.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "text_scan.h"
+
+namespace snag::io {
+namespace {
+
+using detail::is_blank;
+using detail::is_blank_or_eol;
+using detail::quote_token;
+
+class ObjParser {
+ public:
+  ObjParser(std::string_view text, const std::string& name)
+      : p_(text.data()), end_(text.data() + text.size()), name_(name) {}
+
+  mesh::Mesh parse() {
+    reserve();
+    while (p_ < end_) {
+      while (p_ < end_ && is_blank(*p_)) ++p_;
+      if (p_ == end_) break;
+      const char c = *p_;
+      const bool keyword_alone = p_ + 1 == end_ || is_blank_or_eol(p_[1]);
+      if (c == '\n') {
+        ++p_;
+        ++line_;
+        continue;
+      }
+      if (keyword_alone) {
+        if (c == 'v') {
+          parse_vertex();
+        } else if (c == 'f') {
+          parse_face();
+        } else if (c == 'o' || c == 'g') {
+          parse_group();
+        }
+      }
+      skip_line();
+    }
+    check_forward_references();
+    return std::move(mesh_);
+  }
+
+ private:
+  /// Sizes the arrays from a count of `v ` and `f ` lines (one memchr per line, about a tenth
+  /// of the parse), so that they are not copied while growing: with exact sizes the parse
+  /// touches each output page once. Polygons with more corners grow the triangle arrays later.
+  void reserve() {
+    size_t vertices = 0, faces = 0;
+    for (const char* q = p_; q < end_;) {
+      if (q + 1 < end_ && (q[1] == ' ' || q[1] == '\t')) {
+        vertices += q[0] == 'v';
+        faces += q[0] == 'f';
+      }
+      const char* nl = detail::find_eol(q, end_);
+      if (nl == end_) break;
+      q = nl + 1;
+    }
+    mesh_.positions.reserve(vertices);
+    mesh_.triangles.reserve(faces);
+    mesh_.source_polygon.reserve(faces);
+    mesh_.triangle_group.reserve(faces);
+  }
+
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
+
+  void skip_line() {
+    // A parsed `v` or `f` line usually stops right at its end: no memchr call needed.
+    while (p_ < end_ && is_blank(*p_)) ++p_;
+    if (p_ < end_ && *p_ == '\n') {
+      ++p_;
+      ++line_;
+      return;
+    }
+    p_ = detail::find_eol(p_, end_);
+    if (p_ < end_) {
+      ++p_;
+      ++line_;
+    }
+  }
+
+  void skip_blanks() {
+    while (p_ < end_ && is_blank(*p_)) ++p_;
+  }
+  bool at_eol() const { return p_ == end_ || *p_ == '\n'; }
+
+  void parse_vertex() {
+    ++p_;
+    double xyz[3];
+    for (int k = 0; k < 3; ++k) {
+      skip_blanks();
+      if (at_eol()) {
+        fail("vertex has " + std::to_string(k) + " coordinate" + (k == 1 ? "" : "s") +
+             "; expected 3 numbers (x y z)");
+      }
+      const char* start = p_;
+      // fast_float follows std::from_chars and rejects a leading '+', which some writers emit.
+      const char* first = (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-') ? p_ + 1 : p_;
+      auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[k]);
+      if (ec != std::errc() || ptr == first || (ptr < end_ && !is_blank_or_eol(*ptr))) {
+        fail("expected a number for the vertex's " + std::string(1, "xyz"[k]) +
+             " coordinate, found " + quote_token(start, end_));
+      }
+      if (!std::isfinite(xyz[k])) {
+        fail("vertex coordinate " + quote_token(start, end_) +
+             " is not finite; expected a finite number");
+      }
+      p_ = ptr;
+    }
+    mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
+  }
+
+  /// std::from_chars for indices, with a plain digit loop for the usual case of at most 18
+  /// digits (no overflow possible), which is about twice as fast.
+  std::from_chars_result parse_index(const char* first, int64_t& value) const {
+    const char* q = first;
+    uint64_t v = 0;
+    while (q < end_ && q - first < 18 && static_cast<unsigned char>(*q - '0') < 10) {
+      v = v * 10 + static_cast<unsigned>(*q - '0');
+      ++q;
+    }
+    if (q > first && (q == end_ || static_cast<unsigned char>(*q - '0') >= 10)) {
+      value = static_cast<int64_t>(v);
+      return {q, std::errc()};
+    }
+    return std::from_chars(first, end_, value);
+  }
+
+  void parse_face() {
+    ++p_;
+    corners_.clear();
+    const int64_t listed = static_cast<int64_t>(mesh_.positions.size());
+    for (;;) {
+      skip_blanks();
+      if (at_eol() || *p_ == '#') break;  // '#' starts a trailing comment
+      const char* start = p_;
+      const char* first = (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-') ? p_ + 1 : p_;
+      int64_t index = 0;
+      auto [ptr, ec] = parse_index(first, index);
+      if (ec == std::errc::result_out_of_range) {
+        fail("vertex index " + quote_token(start, end_) + " is out of range");
+      }
+      if (ec != std::errc() || ptr == first ||
+          (ptr < end_ && !is_blank_or_eol(*ptr) && *ptr != '/')) {
+        fail("expected a vertex index (an integer, optionally followed by /vt/vn), found " +
+             quote_token(start, end_));
+      }
+      p_ = ptr;
+      // Texture and normal indices are not needed: pass over "/vt", "/vt/vn" or "//vn".
+      while (p_ < end_ && !is_blank_or_eol(*p_)) ++p_;
+      int64_t resolved;
+      if (index > 0) {
+        resolved = index - 1;
+        if (resolved >= std::numeric_limits<int32_t>::max()) {
+          fail("vertex index " + quote_token(start, end_) + " is out of range");
+        }
+        // OBJ lists vertices before the faces that use them in practice, but nothing forbids a
+        // face naming a later vertex: check those once the whole file is read.
+        if (resolved >= listed) forward_.push_back({line_, index, std::string(start, p_)});
+      } else if (index < 0) {
+        resolved = listed + index;
+        if (resolved < 0) {
+          fail("relative vertex index " + quote_token(start, end_) +
+               " points before the first vertex (" + std::to_string(listed) +
+               " vertices listed so far)");
+        }
+      } else {
+        fail("vertex index " + quote_token(start, end_) + " is 0; OBJ indices start at 1");
+      }
+      corners_.push_back(static_cast<int32_t>(resolved));
+    }
+    if (corners_.size() < 3) {
+      fail("face has " + std::to_string(corners_.size()) + " corner" +
+           (corners_.size() == 1 ? "" : "s") + "; expected at least 3");
+    }
+    if (group_pending_) intern_group();
+    const auto polygon = static_cast<int32_t>(mesh_.polygon_count);
+    for (size_t j = 1; j + 1 < corners_.size(); ++j) {
+      mesh_.triangles.push_back({{corners_[0], corners_[j], corners_[j + 1]}});
+      mesh_.source_polygon.push_back(polygon);
+      mesh_.triangle_group.push_back(group_);
+    }
+    ++mesh_.polygon_count;
+  }
+
+  void parse_group() {
+    ++p_;
+    skip_blanks();
+    const char* start = p_;
+    const char* stop = detail::find_eol(p_, end_);
+    while (stop > start && is_blank(stop[-1])) --stop;
+    pending_name_ = std::string_view(start, static_cast<size_t>(stop - start));
+    // An empty `g` returns to the default group; a name is interned only when a face uses it,
+    // so group_names holds names in order of first use.
+    group_pending_ = !pending_name_.empty();
+    if (!group_pending_) group_ = -1;
+  }
+
+  void intern_group() {
+    auto [it, inserted] = group_ids_.try_emplace(std::string(pending_name_),
+                                                 static_cast<int32_t>(mesh_.group_names.size()));
+    if (inserted) mesh_.group_names.emplace_back(pending_name_);
+    group_ = it->second;
+    group_pending_ = false;
+  }
+
+  void check_forward_references() const {
+    const auto count = static_cast<int64_t>(mesh_.positions.size());
+    for (const ForwardReference& ref : forward_) {
+      if (ref.index > count) {
+        throw InputError(name_, ref.line,
+                         "vertex index '" + ref.token + "' is out of range; the file has " +
+                             std::to_string(count) + " vertices (expected 1.." +
+                             std::to_string(count) + " or -1..-" + std::to_string(count) + ")");
+      }
+    }
+  }
+
+  struct ForwardReference {
+    int64_t line;
+    int64_t index;
+    std::string token;
+  };
+
+  const char* p_;
+  const char* end_;
+  const std::string& name_;
+  int64_t line_ = 1;
+  mesh::Mesh mesh_;
+  std::vector<int32_t> corners_;  // reused for every face: no allocation per line
+  std::vector<ForwardReference> forward_;
+  std::string_view pending_name_;
+  bool group_pending_ = false;
+  int32_t group_ = -1;
+  std::unordered_map<std::string, int32_t> group_ids_;
+};
+
+}  // namespace
+
+mesh::Mesh read_obj(std::string_view text, const std::string& name_for_errors) {
+  return ObjParser(text, name_for_errors).parse();
+}
+
+mesh::Mesh read_obj_file(const std::filesystem::path& path) {
+  return read_obj(detail::read_into_thread_buffer(path), path.string());
+}
+
+}  // namespace snag::io

@@ -1,0 +1,727 @@
+// PLY parsing from one in-memory buffer. The header is parsed into a small schema (elements,
+// their properties and types); the body is then walked element by element, reading x/y/z and
+// the vertex index list and stepping over everything else. Binary values are loaded with
+// memcpy (no alignment assumption) and byte-swapped when the file's byte order is not the
+// host's.
+#include "snag/io/ply_reader.h"
+
+#include <fast_float/fast_float.h>
+
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "file_buffer.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "text_scan.h"
+
+namespace snag::io {
+namespace {
+
+using detail::is_blank;
+using detail::is_blank_or_eol;
+using detail::quote_token;
+
+enum class Scalar : uint8_t { i8, u8, i16, u16, i32, u32, f32, f64 };
+
+int scalar_size(Scalar t) {
+  switch (t) {
+    case Scalar::i8:
+    case Scalar::u8:
+      return 1;
+    case Scalar::i16:
+    case Scalar::u16:
+      return 2;
+    case Scalar::i32:
+    case Scalar::u32:
+    case Scalar::f32:
+      return 4;
+    case Scalar::f64:
+      return 8;
+  }
+  return 0;
+}
+
+bool is_integer(Scalar t) {
+  return t != Scalar::f32 && t != Scalar::f64;
+}
+
+bool parse_scalar_name(std::string_view s, Scalar& out) {
+  struct Name {
+    std::string_view name;
+    Scalar type;
+  };
+  static constexpr Name names[] = {
+      {"char", Scalar::i8},     {"int8", Scalar::i8},     {"uchar", Scalar::u8},
+      {"uint8", Scalar::u8},    {"short", Scalar::i16},   {"int16", Scalar::i16},
+      {"ushort", Scalar::u16},  {"uint16", Scalar::u16},  {"int", Scalar::i32},
+      {"int32", Scalar::i32},   {"uint", Scalar::u32},    {"uint32", Scalar::u32},
+      {"float", Scalar::f32},   {"float32", Scalar::f32}, {"double", Scalar::f64},
+      {"float64", Scalar::f64},
+  };
+  for (const Name& n : names) {
+    if (n.name == s) {
+      out = n.type;
+      return true;
+    }
+  }
+  return false;
+}
+
+struct Property {
+  std::string name;
+  Scalar type = Scalar::f32;  // the value type, or the list's item type
+  bool is_list = false;
+  Scalar count_type = Scalar::u8;
+};
+
+struct Element {
+  std::string name;
+  int64_t count = 0;
+  std::vector<Property> properties;
+  int64_t header_line = 0;
+  bool has_list() const {
+    for (const Property& p : properties)
+      if (p.is_list) return true;
+    return false;
+  }
+  /// Bytes of one record in a binary body when it has no list (the list's count otherwise).
+  int64_t min_record_bytes() const {
+    int64_t n = 0;
+    for (const Property& p : properties) n += scalar_size(p.is_list ? p.count_type : p.type);
+    return n;
+  }
+};
+
+enum class Format { ascii, binary_little_endian, binary_big_endian };
+
+struct Header {
+  Format format = Format::ascii;
+  std::vector<Element> elements;
+  size_t body_offset = 0;  // first byte after the end_header line
+  int64_t body_line = 0;   // 1-based line of the body's first byte (ascii)
+};
+
+/// Splits a header line into blank-separated words (at most a handful: no allocation beyond
+/// the vector reused by the caller).
+void split_words(std::string_view line, std::vector<std::string_view>& words) {
+  words.clear();
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    size_t j = i;
+    while (j < line.size() && !is_blank(line[j])) ++j;
+    if (j > i) words.push_back(line.substr(i, j - i));
+    i = j;
+  }
+}
+
+std::string quote(std::string_view s) {
+  return "'" + std::string(s) + "'";
+}
+
+Header parse_header(std::string_view bytes, const std::string& name) {
+  Header h;
+  std::vector<std::string_view> words;
+  size_t pos = 0;
+  int64_t line = 0;
+  bool have_format = false;
+  auto fail = [&](const std::string& what) -> void { throw InputError(name, line, what); };
+  for (;;) {
+    if (pos >= bytes.size()) {
+      fail(line == 0 ? "file is empty; expected a PLY header starting with 'ply'"
+                     : "file ends inside the PLY header; expected an 'end_header' line");
+    }
+    ++line;
+    size_t nl = bytes.find('\n', pos);
+    if (nl == std::string_view::npos) nl = bytes.size();
+    std::string_view text = bytes.substr(pos, nl - pos);
+    pos = nl + 1;
+    split_words(text, words);
+    if (line == 1) {
+      if (words.size() != 1 || words[0] != "ply") {
+        fail("expected 'ply' on the first line, found " +
+             (words.empty() ? std::string("an empty line") : quote(text.substr(0, 40))));
+      }
+      continue;
+    }
+    if (words.empty()) continue;
+    const std::string_view key = words[0];
+    if (key == "comment" || key == "obj_info") continue;
+    if (key == "end_header") {
+      if (!have_format)
+        fail(
+            "header has no 'format' line; expected 'format "
+            "ascii|binary_little_endian|binary_big_endian 1.0'");
+      h.body_offset = std::min(pos, bytes.size());
+      h.body_line = line + 1;
+      return h;
+    }
+    if (key == "format") {
+      if (words.size() != 3) fail("expected 'format <encoding> 1.0', found " + quote(text));
+      if (words[1] == "ascii") {
+        h.format = Format::ascii;
+      } else if (words[1] == "binary_little_endian") {
+        h.format = Format::binary_little_endian;
+      } else if (words[1] == "binary_big_endian") {
+        h.format = Format::binary_big_endian;
+      } else {
+        fail("unknown PLY format " + quote(words[1]) +
+             "; expected ascii, binary_little_endian or binary_big_endian");
+      }
+      have_format = true;
+    } else if (key == "element") {
+      if (words.size() != 3) fail("expected 'element <name> <count>', found " + quote(text));
+      Element e;
+      e.name = std::string(words[1]);
+      e.header_line = line;
+      auto [ptr, ec] = std::from_chars(words[2].data(), words[2].data() + words[2].size(), e.count);
+      if (ec != std::errc() || ptr != words[2].data() + words[2].size() || e.count < 0) {
+        fail("element " + quote(words[1]) + " has count " + quote(words[2]) +
+             "; expected a non-negative integer");
+      }
+      h.elements.push_back(std::move(e));
+    } else if (key == "property") {
+      if (h.elements.empty()) fail("property before any element: " + quote(text));
+      Property p;
+      if (words.size() >= 2 && words[1] == "list") {
+        if (words.size() != 5)
+          fail("expected 'property list <count type> <item type> <name>', found " + quote(text));
+        p.is_list = true;
+        if (!parse_scalar_name(words[2], p.count_type)) {
+          fail("unsupported property type " + quote(words[2]) +
+               "; expected char, uchar, short, ushort, int, uint, float, double or int8 ... "
+               "float64");
+        }
+        if (!parse_scalar_name(words[3], p.type)) {
+          fail("unsupported property type " + quote(words[3]) +
+               "; expected char, uchar, short, ushort, int, uint, float, double or int8 ... "
+               "float64");
+        }
+        if (!is_integer(p.count_type)) {
+          fail("list count type " + quote(words[2]) + " is not an integer type");
+        }
+        p.name = std::string(words[4]);
+      } else {
+        if (words.size() != 3) fail("expected 'property <type> <name>', found " + quote(text));
+        if (!parse_scalar_name(words[1], p.type)) {
+          fail("unsupported property type " + quote(words[1]) +
+               "; expected char, uchar, short, ushort, int, uint, float, double or int8 ... "
+               "float64");
+        }
+        p.name = std::string(words[2]);
+      }
+      h.elements.back().properties.push_back(std::move(p));
+    } else {
+      fail("unknown header line " + quote(text.substr(0, 60)) +
+           "; expected format, element, property, comment, obj_info or end_header");
+    }
+  }
+}
+
+/// What the body walk needs to know: where x, y, z and the index list are.
+struct Plan {
+  int vertex_element = -1;
+  int face_element = -1;
+  int xyz[3] = {-1, -1, -1};  // property indices in the vertex element
+  int indices = -1;           // property index of the face element's vertex index list
+};
+
+Plan make_plan(const Header& h, const std::string& name) {
+  Plan plan;
+  for (size_t e = 0; e < h.elements.size(); ++e) {
+    const Element& el = h.elements[e];
+    if (el.name == "vertex" && plan.vertex_element < 0) {
+      plan.vertex_element = static_cast<int>(e);
+      for (size_t k = 0; k < el.properties.size(); ++k) {
+        const Property& p = el.properties[k];
+        const int axis = p.name == "x" ? 0 : p.name == "y" ? 1 : p.name == "z" ? 2 : -1;
+        if (axis < 0) continue;
+        if (p.is_list) {
+          throw InputError(
+              name, el.header_line,
+              "vertex property " + quote(p.name) + " is a list; expected a scalar coordinate");
+        }
+        plan.xyz[axis] = static_cast<int>(k);
+      }
+      for (int axis = 0; axis < 3; ++axis) {
+        if (plan.xyz[axis] < 0) {
+          throw InputError(name, el.header_line,
+                           std::string("element 'vertex' has no property '") + "xyz"[axis] +
+                               "'; expected x, y and z");
+        }
+      }
+      if (el.count > std::numeric_limits<int32_t>::max()) {
+        throw InputError(
+            name, el.header_line,
+            "vertex count " + std::to_string(el.count) + " exceeds the supported 2^31-1");
+      }
+    } else if (el.name == "face" && plan.face_element < 0) {
+      plan.face_element = static_cast<int>(e);
+      for (size_t k = 0; k < el.properties.size(); ++k) {
+        const Property& p = el.properties[k];
+        if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+          plan.indices = static_cast<int>(k);
+          break;
+        }
+      }
+      if (plan.indices < 0) {
+        throw InputError(name, el.header_line,
+                         "element 'face' has no list property 'vertex_indices' or 'vertex_index'");
+      }
+      if (!is_integer(el.properties[plan.indices].type)) {
+        throw InputError(name, el.header_line,
+                         "face vertex indices are floating point; expected an integer type");
+      }
+      if (el.count > std::numeric_limits<int32_t>::max()) {
+        throw InputError(
+            name, el.header_line,
+            "face count " + std::to_string(el.count) + " exceeds the supported 2^31-1");
+      }
+    }
+  }
+  if (plan.vertex_element < 0) throw InputError(name, 0, "PLY header has no 'vertex' element");
+  if (plan.face_element < 0) {
+    throw InputError(name, 0,
+                     "PLY header has no 'face' element; expected a triangle or polygon mesh");
+  }
+  return plan;
+}
+
+/// Adds polygon `polygon` (corners already validated) as a fan of triangles.
+void add_polygon(mesh::Mesh& m, const std::vector<int32_t>& corners, int32_t polygon) {
+  for (size_t j = 1; j + 1 < corners.size(); ++j) {
+    m.triangles.push_back({{corners[0], corners[j], corners[j + 1]}});
+    m.source_polygon.push_back(polygon);
+    m.triangle_group.push_back(-1);
+  }
+}
+
+std::string record_name(const Element& el, int64_t i) {
+  return el.name + " " + std::to_string(i) + " (of " + std::to_string(el.count) + ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Binary body.
+
+template <bool Swap>
+class BinaryBody {
+ public:
+  BinaryBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name)
+      : base_(bytes.data()),
+        p_(bytes.data() + h.body_offset),
+        end_(bytes.data() + bytes.size()),
+        h_(h),
+        plan_(plan),
+        name_(name) {}
+
+  mesh::Mesh parse() {
+    for (size_t e = 0; e < h_.elements.size(); ++e) {
+      const Element& el = h_.elements[e];
+      if (static_cast<int>(e) == plan_.vertex_element) {
+        read_vertices(el);
+      } else if (static_cast<int>(e) == plan_.face_element) {
+        read_faces(el);
+      } else {
+        skip_element(el);
+      }
+    }
+    return std::move(mesh_);
+  }
+
+ private:
+  int64_t offset(const char* p) const { return p - base_; }
+
+  [[noreturn]] void truncated(const Element& el, int64_t i, const char* at, int64_t needed) const {
+    throw InputError(name_, 0,
+                     "file is truncated: it ends inside " + record_name(el, i) + "; expected " +
+                         std::to_string(needed) + " more bytes, found " + std::to_string(end_ - at),
+                     offset(at));
+  }
+  void need(const Element& el, int64_t i, int64_t bytes) const {
+    if (end_ - p_ < bytes) truncated(el, i, p_, bytes);
+  }
+
+  static uint16_t load16(const char* p) {
+    uint16_t v;
+    std::memcpy(&v, p, 2);
+    if constexpr (Swap) v = __builtin_bswap16(v);
+    return v;
+  }
+  static uint32_t load32(const char* p) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    if constexpr (Swap) v = __builtin_bswap32(v);
+    return v;
+  }
+  static uint64_t load64(const char* p) {
+    uint64_t v;
+    std::memcpy(&v, p, 8);
+    if constexpr (Swap) v = __builtin_bswap64(v);
+    return v;
+  }
+  static double load_double(const char* p, Scalar t) {
+    switch (t) {
+      case Scalar::i8:
+        return static_cast<int8_t>(*p);
+      case Scalar::u8:
+        return static_cast<uint8_t>(*p);
+      case Scalar::i16:
+        return static_cast<int16_t>(load16(p));
+      case Scalar::u16:
+        return load16(p);
+      case Scalar::i32:
+        return static_cast<int32_t>(load32(p));
+      case Scalar::u32:
+        return load32(p);
+      case Scalar::f32:
+        return std::bit_cast<float>(load32(p));
+      case Scalar::f64:
+        return std::bit_cast<double>(load64(p));
+    }
+    return 0;
+  }
+  static int64_t load_int(const char* p, Scalar t) {
+    switch (t) {
+      case Scalar::i8:
+        return static_cast<int8_t>(*p);
+      case Scalar::u8:
+        return static_cast<uint8_t>(*p);
+      case Scalar::i16:
+        return static_cast<int16_t>(load16(p));
+      case Scalar::u16:
+        return load16(p);
+      case Scalar::i32:
+        return static_cast<int32_t>(load32(p));
+      case Scalar::u32:
+        return load32(p);
+      default:
+        return 0;  // excluded by make_plan: counts and indices are integer types
+    }
+  }
+
+  void read_vertices(const Element& el) {
+    const int64_t min_bytes = el.min_record_bytes();
+    // Checked before allocating, so that a corrupt count cannot ask for terabytes.
+    if (min_bytes > 0 && el.count > (end_ - p_) / min_bytes) {
+      truncated(el, (end_ - p_) / min_bytes, p_ + ((end_ - p_) / min_bytes) * min_bytes, min_bytes);
+    }
+    mesh_.positions.resize(static_cast<size_t>(el.count));
+    int offsets[3];
+    Scalar types[3];
+    if (!el.has_list()) {
+      // Fixed-size records: the coordinates sit at fixed offsets within a fixed stride.
+      for (int axis = 0; axis < 3; ++axis) {
+        int off = 0;
+        for (int k = 0; k < plan_.xyz[axis]; ++k) off += scalar_size(el.properties[k].type);
+        offsets[axis] = off;
+        types[axis] = el.properties[plan_.xyz[axis]].type;
+      }
+      for (int64_t i = 0; i < el.count; ++i, p_ += min_bytes) {
+        double xyz[3];
+        for (int axis = 0; axis < 3; ++axis) {
+          xyz[axis] = load_double(p_ + offsets[axis], types[axis]);
+          if (!std::isfinite(xyz[axis])) bad_coordinate(el, i, axis, xyz[axis], p_ + offsets[axis]);
+        }
+        mesh_.positions[i] = {xyz[0], xyz[1], xyz[2]};
+      }
+      return;
+    }
+    for (int64_t i = 0; i < el.count; ++i) {
+      double xyz[3] = {0, 0, 0};
+      for (size_t k = 0; k < el.properties.size(); ++k) {
+        const Property& prop = el.properties[k];
+        if (prop.is_list) {
+          skip_list(el, i, prop);
+          continue;
+        }
+        const int size = scalar_size(prop.type);
+        need(el, i, size);
+        for (int axis = 0; axis < 3; ++axis) {
+          if (plan_.xyz[axis] == static_cast<int>(k)) {
+            xyz[axis] = load_double(p_, prop.type);
+            if (!std::isfinite(xyz[axis])) bad_coordinate(el, i, axis, xyz[axis], p_);
+          }
+        }
+        p_ += size;
+      }
+      mesh_.positions[i] = {xyz[0], xyz[1], xyz[2]};
+    }
+  }
+
+  [[noreturn]] void bad_coordinate(const Element& el, int64_t i, int axis, double v,
+                                   const char* at) const {
+    throw InputError(name_, 0,
+                     std::string(1, "xyz"[axis]) + " coordinate of " + record_name(el, i) + " is " +
+                         (std::isnan(v) ? "NaN" : "infinite") + "; expected a finite number",
+                     offset(at));
+  }
+
+  void skip_list(const Element& el, int64_t i, const Property& prop) {
+    const int count_size = scalar_size(prop.count_type);
+    need(el, i, count_size);
+    const int64_t n = load_int(p_, prop.count_type);
+    if (n < 0) {
+      throw InputError(name_, 0,
+                       "list " + quote(prop.name) + " of " + record_name(el, i) + " has count " +
+                           std::to_string(n) + "; expected a non-negative count",
+                       offset(p_));
+    }
+    p_ += count_size;
+    need(el, i, n * scalar_size(prop.type));
+    p_ += n * scalar_size(prop.type);
+  }
+
+  void read_faces(const Element& el) {
+    const int64_t min_bytes = el.min_record_bytes();
+    if (min_bytes > 0 && el.count > (end_ - p_) / min_bytes) {
+      truncated(el, (end_ - p_) / min_bytes, p_ + ((end_ - p_) / min_bytes) * min_bytes, min_bytes);
+    }
+    const Element& vertices = h_.elements[plan_.vertex_element];
+    const int64_t vertex_count = vertices.count;
+    mesh_.triangles.reserve(static_cast<size_t>(el.count));
+    mesh_.source_polygon.reserve(static_cast<size_t>(el.count));
+    mesh_.triangle_group.reserve(static_cast<size_t>(el.count));
+    const Property& list = el.properties[plan_.indices];
+    const int count_size = scalar_size(list.count_type);
+    const int index_size = scalar_size(list.type);
+    for (int64_t i = 0; i < el.count; ++i) {
+      for (size_t k = 0; k < el.properties.size(); ++k) {
+        const Property& prop = el.properties[k];
+        if (static_cast<int>(k) != plan_.indices) {
+          if (prop.is_list) {
+            skip_list(el, i, prop);
+          } else {
+            need(el, i, scalar_size(prop.type));
+            p_ += scalar_size(prop.type);
+          }
+          continue;
+        }
+        need(el, i, count_size);
+        const int64_t n = load_int(p_, list.count_type);
+        if (n < 3) {
+          throw InputError(
+              name_, 0,
+              record_name(el, i) + " has " + std::to_string(n) + " corners; expected at least 3",
+              offset(p_));
+        }
+        p_ += count_size;
+        need(el, i, n * index_size);
+        corners_.clear();
+        for (int64_t c = 0; c < n; ++c, p_ += index_size) {
+          const int64_t v = load_int(p_, list.type);
+          if (v < 0 || v >= vertex_count) {
+            throw InputError(name_, 0,
+                             "corner " + std::to_string(c) + " of " + record_name(el, i) +
+                                 " is vertex " + std::to_string(v) + "; expected 0.." +
+                                 std::to_string(vertex_count - 1) + " (" +
+                                 std::to_string(vertex_count) + " vertices)",
+                             offset(p_));
+          }
+          corners_.push_back(static_cast<int32_t>(v));
+        }
+        add_polygon(mesh_, corners_, static_cast<int32_t>(i));
+      }
+    }
+    mesh_.polygon_count = el.count;
+  }
+
+  void skip_element(const Element& el) {
+    if (!el.has_list()) {
+      const int64_t stride = el.min_record_bytes();
+      if (stride > 0 && el.count > (end_ - p_) / stride) {
+        truncated(el, (end_ - p_) / stride, p_ + ((end_ - p_) / stride) * stride, stride);
+      }
+      p_ += el.count * stride;
+      return;
+    }
+    for (int64_t i = 0; i < el.count; ++i) {
+      for (const Property& prop : el.properties) {
+        if (prop.is_list) {
+          skip_list(el, i, prop);
+        } else {
+          need(el, i, scalar_size(prop.type));
+          p_ += scalar_size(prop.type);
+        }
+      }
+    }
+  }
+
+  const char* base_;
+  const char* p_;
+  const char* end_;
+  const Header& h_;
+  const Plan& plan_;
+  const std::string& name_;
+  mesh::Mesh mesh_;
+  std::vector<int32_t> corners_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Ascii body: blank-separated tokens; records usually sit one per line, but only the token
+// order matters. Lines are counted for error messages.
+
+class AsciiBody {
+ public:
+  AsciiBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name)
+      : p_(bytes.data() + h.body_offset),
+        end_(bytes.data() + bytes.size()),
+        line_(h.body_line),
+        h_(h),
+        plan_(plan),
+        name_(name) {}
+
+  mesh::Mesh parse() {
+    for (size_t e = 0; e < h_.elements.size(); ++e) {
+      const Element& el = h_.elements[e];
+      const bool is_vertex = static_cast<int>(e) == plan_.vertex_element;
+      const bool is_face = static_cast<int>(e) == plan_.face_element;
+      // Each record takes at least one character and a separator per value.
+      if (el.count > 0 && !el.properties.empty() &&
+          el.count > (end_ - p_ + 1) / (2 * static_cast<int64_t>(el.properties.size()))) {
+        throw InputError(name_, line_,
+                         "element " + quote(el.name) + " declares " + std::to_string(el.count) +
+                             " records, more than the rest of the file can hold");
+      }
+      if (is_vertex) mesh_.positions.reserve(static_cast<size_t>(el.count));
+      for (int64_t i = 0; i < el.count; ++i) {
+        if (is_vertex) {
+          read_vertex(el, i);
+        } else if (is_face) {
+          read_face(el, i);
+        } else {
+          for (const Property& prop : el.properties) {
+            const int64_t n = prop.is_list ? next_integer(el, i, prop, "list count") : 1;
+            if (n < 0)
+              fail("list count " + std::to_string(n) + " is negative; expected a count >= 0");
+            for (int64_t k = 0; k < n; ++k) next_token(el, i);
+          }
+        }
+      }
+      if (is_face) mesh_.polygon_count = el.count;
+    }
+    return std::move(mesh_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
+
+  /// Moves to the next token, counting line ends on the way; fails at the end of the file.
+  const char* next_token(const Element& el, int64_t i) {
+    while (p_ < end_ && is_blank_or_eol(*p_)) {
+      if (*p_ == '\n') ++line_;
+      ++p_;
+    }
+    if (p_ == end_) fail("file ends inside " + record_name(el, i) + "; expected more values");
+    const char* start = p_;
+    while (p_ < end_ && !is_blank_or_eol(*p_)) ++p_;
+    return start;
+  }
+
+  int64_t next_integer(const Element& el, int64_t i, const Property& prop, const char* what) {
+    const char* start = next_token(el, i);
+    int64_t v = 0;
+    auto [ptr, ec] = std::from_chars(start, p_, v);
+    if (ec != std::errc() || ptr != p_) {
+      fail(std::string("expected an integer ") + what + " for " + quote(prop.name) + " of " +
+           record_name(el, i) + ", found " + quote_token(start, end_));
+    }
+    return v;
+  }
+
+  void read_vertex(const Element& el, int64_t i) {
+    double xyz[3] = {0, 0, 0};
+    for (size_t k = 0; k < el.properties.size(); ++k) {
+      const Property& prop = el.properties[k];
+      if (prop.is_list) {
+        const int64_t n = next_integer(el, i, prop, "list count");
+        for (int64_t c = 0; c < n; ++c) next_token(el, i);
+        continue;
+      }
+      const char* start = next_token(el, i);
+      for (int axis = 0; axis < 3; ++axis) {
+        if (plan_.xyz[axis] != static_cast<int>(k)) continue;
+        const char* first = (*start == '+' && start + 1 < p_) ? start + 1 : start;
+        auto [ptr, ec] = fast_float::from_chars(first, p_, xyz[axis]);
+        if (ec != std::errc() || ptr != p_) {
+          fail(std::string("expected a number for the ") + "xyz"[axis] + " coordinate of " +
+               record_name(el, i) + ", found " + quote_token(start, end_));
+        }
+        if (!std::isfinite(xyz[axis])) {
+          fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+               record_name(el, i) + " is not finite; expected a finite number");
+        }
+      }
+    }
+    mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
+  }
+
+  void read_face(const Element& el, int64_t i) {
+    const int64_t vertex_count = h_.elements[plan_.vertex_element].count;
+    for (size_t k = 0; k < el.properties.size(); ++k) {
+      const Property& prop = el.properties[k];
+      if (static_cast<int>(k) != plan_.indices) {
+        const int64_t n = prop.is_list ? next_integer(el, i, prop, "list count") : 1;
+        for (int64_t c = 0; c < n; ++c) next_token(el, i);
+        continue;
+      }
+      const int64_t n = next_integer(el, i, prop, "corner count");
+      if (n < 3) {
+        fail(record_name(el, i) + " has " + std::to_string(n) + " corners; expected at least 3");
+      }
+      corners_.clear();
+      for (int64_t c = 0; c < n; ++c) {
+        const int64_t v = next_integer(el, i, prop, "vertex index");
+        if (v < 0 || v >= vertex_count) {
+          fail("corner " + std::to_string(c) + " of " + record_name(el, i) + " is vertex " +
+               std::to_string(v) + "; expected 0.." + std::to_string(vertex_count - 1) + " (" +
+               std::to_string(vertex_count) + " vertices)");
+        }
+        corners_.push_back(static_cast<int32_t>(v));
+      }
+      add_polygon(mesh_, corners_, static_cast<int32_t>(i));
+    }
+  }
+
+  const char* p_;
+  const char* end_;
+  int64_t line_;
+  const Header& h_;
+  const Plan& plan_;
+  const std::string& name_;
+  mesh::Mesh mesh_;
+  std::vector<int32_t> corners_;
+};
+
+}  // namespace
+
+mesh::Mesh read_ply(std::string_view bytes, const std::string& name_for_errors) {
+  const Header header = parse_header(bytes, name_for_errors);
+  const Plan plan = make_plan(header, name_for_errors);
+  constexpr bool host_little = std::endian::native == std::endian::little;
+  switch (header.format) {
+    case Format::ascii:
+      return AsciiBody(bytes, header, plan, name_for_errors).parse();
+    case Format::binary_little_endian:
+      if constexpr (host_little)
+        return BinaryBody<false>(bytes, header, plan, name_for_errors).parse();
+      else
+        return BinaryBody<true>(bytes, header, plan, name_for_errors).parse();
+    case Format::binary_big_endian:
+      if constexpr (host_little)
+        return BinaryBody<true>(bytes, header, plan, name_for_errors).parse();
+      else
+        return BinaryBody<false>(bytes, header, plan, name_for_errors).parse();
+  }
+  throw InternalError("unreachable PLY format");
+}
+
+mesh::Mesh read_ply_file(const std::filesystem::path& path) {
+  return read_ply(detail::read_into_thread_buffer(path), path.string());
+}
+
+}  // namespace snag::io

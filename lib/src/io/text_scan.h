@@ -1,0 +1,40 @@
+// Small helpers shared by the text readers (OBJ, ascii PLY): character classes and quoting the
+// offending token in error messages. Private to lib/src/io.
+#pragma once
+
+#include <cstring>
+#include <string>
+
+namespace snag::io::detail {
+
+/// Blanks inside a line. '\r' counts as one so that CRLF files need no special case.
+inline bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+inline bool is_blank_or_eol(char c) {
+  return is_blank(c) || c == '\n';
+}
+
+/// The next '\n' at or after `p`, or `end`.
+inline const char* find_eol(const char* p, const char* end) {
+  if (p >= end) return end;
+  const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
+  return nl ? static_cast<const char*>(nl) : end;
+}
+
+/// The whitespace-delimited token starting at `p`, quoted, shortened past 40 characters so that
+/// a binary file read as text does not flood the message.
+inline std::string quote_token(const char* p, const char* end) {
+  const char* q = p;
+  while (q < end && !is_blank_or_eol(*q) && q - p < 40) ++q;
+  if (q == p) return p == end ? "end of file" : "end of line";
+  std::string s;
+  s.reserve(static_cast<size_t>(q - p) + 5);
+  s += '\'';
+  s.append(p, q);
+  if (q < end && !is_blank_or_eol(*q)) s += "...";
+  s += '\'';
+  return s;
+}
+
+}  // namespace snag::io::detail

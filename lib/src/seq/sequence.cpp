@@ -1,0 +1,356 @@
+// Sequence resolution by directory listing: patterns and globs are matched against the names in
+// one directory, never handed to a shell.
+#include "snag/seq/sequence.h"
+
+#include <algorithm>
+#include <charconv>
+#include <optional>
+#include <system_error>
+
+#include "snag/error.h"
+
+namespace snag::seq {
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
+
+char lower(char c) {
+  return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+}
+
+bool is_frame_file_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  for (char& c : ext) c = lower(c);
+  return ext == ".obj" || ext == ".ply";
+}
+
+/// A file name split around its frame token.
+struct FramePattern {
+  std::string prefix;
+  std::string suffix;
+  int width = 1;  // printf's minimum width; 1 means unpadded
+};
+
+/// Finds the frame token in a file name. Returns nothing when there is none.
+std::optional<FramePattern> find_frame_token(const std::string& name, const std::string& sequence) {
+  std::optional<FramePattern> found;
+  size_t i = 0;
+  while (i < name.size()) {
+    size_t start = i, stop = i;
+    int width = 0;
+    const char c = name[i];
+    if (c == '%') {
+      size_t j = i + 1;
+      while (j < name.size() && is_digit(name[j])) ++j;
+      if (j < name.size() && name[j] == 'd') {
+        width = 1;
+        if (j > i + 1) std::from_chars(name.data() + i + 1, name.data() + j, width);
+        stop = j + 1;
+      }
+    } else if (c == '#' || c == '@') {
+      size_t j = i;
+      while (j < name.size() && name[j] == c) ++j;
+      width = static_cast<int>(j - i);
+      stop = j;
+    } else if (c == '$' && i + 1 < name.size() && name[i + 1] == 'F') {
+      size_t j = i + 2;
+      while (j < name.size() && is_digit(name[j])) ++j;
+      width = 1;
+      if (j > i + 2) std::from_chars(name.data() + i + 2, name.data() + j, width);
+      stop = j;
+    }
+    if (stop == start) {
+      ++i;
+      continue;
+    }
+    if (found) {
+      throw UsageError(
+          "sequence pattern '" + sequence +
+          "' has more than one frame token; expected one of %04d, %d, ####, @, $F4 or $F");
+    }
+    found = FramePattern{name.substr(0, start), name.substr(stop), std::max(width, 1)};
+    i = stop;
+  }
+  if (found) {
+    // The rest of the name is matched literally: reject what was probably meant as a glob.
+    for (const std::string* part : {&found->prefix, &found->suffix}) {
+      if (part->find_first_of("*?[") != std::string::npos) {
+        throw UsageError("sequence pattern '" + sequence +
+                         "' mixes a frame token with glob characters; use one or the other");
+      }
+    }
+  }
+  return found;
+}
+
+int64_t parse_frame_digits(std::string_view digits, const std::string& path) {
+  int64_t v = 0;
+  auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+  if (ec != std::errc() || ptr != digits.data() + digits.size()) {
+    throw InputError(path, 0, "frame number '" + std::string(digits) + "' does not fit in 64 bits");
+  }
+  return v;
+}
+
+/// Matches `name` against the pattern; the frame number on success.
+std::optional<int64_t> match_frame_pattern(const std::string& name, const FramePattern& pat,
+                                           const std::string& path) {
+  if (name.size() <= pat.prefix.size() + pat.suffix.size()) return std::nullopt;
+  if (name.compare(0, pat.prefix.size(), pat.prefix) != 0) return std::nullopt;
+  if (name.compare(name.size() - pat.suffix.size(), pat.suffix.size(), pat.suffix) != 0)
+    return std::nullopt;
+  const std::string_view middle = std::string_view(name).substr(
+      pat.prefix.size(), name.size() - pat.prefix.size() - pat.suffix.size());
+  const bool negative = middle[0] == '-';
+  const std::string_view digits = middle.substr(negative ? 1 : 0);
+  if (digits.empty() || !std::all_of(digits.begin(), digits.end(), is_digit)) return std::nullopt;
+  // printf writes leading zeros only to reach the width, and never shortens a number.
+  const auto length = static_cast<int64_t>(middle.size());
+  const bool zero_padded = digits.size() > 1 && digits[0] == '0';
+  if (zero_padded ? length != pat.width : length < pat.width) return std::nullopt;
+  const int64_t magnitude = parse_frame_digits(digits, path);
+  return negative ? -magnitude : magnitude;
+}
+
+/// fnmatch-style matching of one path component: `*`, `?`, `[abc]`, `[a-z]`, `[!a]`/`[^a]`.
+bool glob_match(std::string_view pattern, std::string_view name) {
+  size_t p = 0, n = 0;
+  size_t star_p = std::string_view::npos, star_n = 0;
+  while (n < name.size()) {
+    bool advanced = false;
+    if (p < pattern.size()) {
+      const char pc = pattern[p];
+      if (pc == '*') {
+        star_p = p++;
+        star_n = n;
+        continue;
+      }
+      if (pc == '?') {
+        ++p;
+        ++n;
+        advanced = true;
+      } else if (pc == '[') {
+        size_t q = p + 1;
+        bool negate = q < pattern.size() && (pattern[q] == '!' || pattern[q] == '^');
+        if (negate) ++q;
+        bool matched = false;
+        size_t first = q;
+        while (q < pattern.size() && (pattern[q] != ']' || q == first)) {
+          if (q + 2 < pattern.size() && pattern[q + 1] == '-' && pattern[q + 2] != ']') {
+            if (pattern[q] <= name[n] && name[n] <= pattern[q + 2]) matched = true;
+            q += 3;
+          } else {
+            if (pattern[q] == name[n]) matched = true;
+            ++q;
+          }
+        }
+        if (q < pattern.size()) {  // a closed class
+          if (matched != negate) {
+            p = q + 1;
+            ++n;
+            advanced = true;
+          }
+        } else if (name[n] == '[') {  // an unclosed '[' is a literal
+          ++p;
+          ++n;
+          advanced = true;
+        }
+      } else if (pc == name[n]) {
+        ++p;
+        ++n;
+        advanced = true;
+      }
+    }
+    if (advanced) continue;
+    if (star_p == std::string_view::npos) return false;
+    p = star_p + 1;
+    n = ++star_n;
+  }
+  while (p < pattern.size() && pattern[p] == '*') ++p;
+  return p == pattern.size();
+}
+
+/// Regular files (symlinks followed) directly in `dir`, by name.
+std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequence) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec);
+  if (ec)
+    throw InputError(sequence, 0, "cannot list directory '" + dir.string() + "': " + ec.message());
+  for (const fs::directory_entry& entry : it) {
+    std::error_code type_ec;
+    if (entry.is_regular_file(type_ec))
+      files.push_back(dir.empty() ? entry.path().filename() : entry.path());
+  }
+  return files;
+}
+
+std::vector<Frame> sorted_unique(std::vector<Frame> frames, const std::string& sequence) {
+  std::sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) {
+    return a.number != b.number ? a.number < b.number : a.path < b.path;
+  });
+  for (size_t i = 1; i < frames.size(); ++i) {
+    if (frames[i].number == frames[i - 1].number) {
+      throw InputError(sequence, 0,
+                       "two files have frame number " + std::to_string(frames[i].number) + ": '" +
+                           frames[i - 1].path.string() + "' and '" + frames[i].path.string() +
+                           "'; expected one file per frame (name a pattern to pick one set)");
+    }
+  }
+  return frames;
+}
+
+}  // namespace
+
+int64_t frame_number_from_name(const fs::path& path) {
+  const std::string stem = path.stem().string();
+  size_t end = stem.size();
+  while (end > 0 && !is_digit(stem[end - 1])) --end;
+  if (end == 0) return 0;
+  size_t begin = end;
+  while (begin > 0 && is_digit(stem[begin - 1])) --begin;
+  return parse_frame_digits(std::string_view(stem).substr(begin, end - begin), path.string());
+}
+
+std::vector<Frame> resolve_sequence(const std::string& sequence) {
+  if (sequence.empty())
+    throw UsageError(
+        "the sequence argument is empty; expected a file, a directory, a pattern or a glob");
+  const fs::path spec(sequence);
+  std::error_code ec;
+  const fs::file_status status = fs::status(spec, ec);
+  if (fs::is_directory(status)) {
+    std::vector<Frame> frames;
+    for (const fs::path& file : list_files(spec, sequence)) {
+      if (is_frame_file_extension(file)) frames.push_back({frame_number_from_name(file), file});
+    }
+    if (frames.empty()) throw InputError(sequence, 0, "directory has no .obj or .ply files");
+    return sorted_unique(std::move(frames), sequence);
+  }
+  if (fs::exists(status)) return {{frame_number_from_name(spec), spec}};
+
+  const fs::path dir = spec.parent_path();
+  const std::string name = spec.filename().string();
+  const std::optional<FramePattern> pattern = find_frame_token(name, sequence);
+  const bool is_glob = !pattern && name.find_first_of("*?[") != std::string::npos;
+  if (!pattern && !is_glob) {
+    throw InputError(
+        sequence, 0,
+        "no such file or directory; expected a file, a directory, a pattern with %04d, "
+        "####, @ or $F4, or a glob");
+  }
+  if (!dir.empty() && !fs::is_directory(dir, ec)) {
+    throw InputError(sequence, 0, "directory '" + dir.string() + "' does not exist");
+  }
+  std::vector<Frame> frames;
+  for (const fs::path& file : list_files(dir, sequence)) {
+    const std::string file_name = file.filename().string();
+    if (pattern) {
+      if (auto number = match_frame_pattern(file_name, *pattern, file.string()))
+        frames.push_back({*number, file});
+    } else if (glob_match(name, file_name)) {
+      frames.push_back({frame_number_from_name(file), file});
+    }
+  }
+  if (frames.empty()) {
+    throw InputError(sequence, 0,
+                     std::string("no files match the ") + (pattern ? "pattern" : "glob") + " in '" +
+                         (dir.empty() ? std::string(".") : dir.string()) + "'");
+  }
+  return sorted_unique(std::move(frames), sequence);
+}
+
+FrameSelection FrameSelection::parse(std::string_view text) {
+  FrameSelection sel;
+  sel.text_ = std::string(text);
+  sel.all_ = false;
+  const std::string expected =
+      "; expected N, FIRST-LAST or FIRST-LASTxSTEP, separated by commas (e.g. 1-240x5,300)";
+  auto trim = [](std::string_view s) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+    return s;
+  };
+  size_t pos = 0;
+  for (;;) {
+    const size_t comma = text.find(',', pos);
+    const std::string_view item =
+        trim(text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos));
+    const std::string quoted = "'" + std::string(item) + "'";
+    if (item.empty())
+      throw UsageError("frame selection '" + std::string(text) + "' has an empty item" + expected);
+    const char* p = item.data();
+    const char* end = item.data() + item.size();
+    auto number = [&](int64_t& out) {
+      auto [ptr, ec] = std::from_chars(p, end, out);
+      if (ec != std::errc()) {
+        throw UsageError("frame selection item " + quoted + " has a bad number at '" +
+                         std::string(p, end) + "'" + expected);
+      }
+      p = ptr;
+    };
+    Range r{0, 0, 1};
+    number(r.first);
+    r.last = r.first;
+    if (p < end && *p == '-') {
+      ++p;
+      number(r.last);
+      if (p < end && *p == 'x') {
+        ++p;
+        number(r.step);
+        if (r.step <= 0)
+          throw UsageError("frame selection item " + quoted + " has step " +
+                           std::to_string(r.step) + "; expected a step of 1 or more");
+      }
+    }
+    if (p != end) {
+      throw UsageError("frame selection item " + quoted + " has unexpected '" +
+                       std::string(p, end) + "'" + expected);
+    }
+    if (r.last < r.first) {
+      throw UsageError("frame selection item " + quoted +
+                       " ends before it starts; expected FIRST <= LAST");
+    }
+    sel.ranges_.push_back(r);
+    if (comma == std::string_view::npos) break;
+    pos = comma + 1;
+  }
+  return sel;
+}
+
+bool FrameSelection::contains(int64_t frame) const {
+  if (all_) return true;
+  for (const Range& r : ranges_) {
+    // Unsigned difference: last - first cannot overflow for any pair of int64 frame numbers.
+    if (frame >= r.first && frame <= r.last &&
+        (static_cast<uint64_t>(frame) - static_cast<uint64_t>(r.first)) %
+                static_cast<uint64_t>(r.step) ==
+            0) {
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<Frame> select_frames(const std::vector<Frame>& frames,
+                                 const FrameSelection& selection) {
+  std::vector<Frame> kept;
+  for (const Frame& f : frames) {
+    if (selection.contains(f.number)) kept.push_back(f);
+  }
+  if (kept.empty() && !frames.empty()) {
+    const auto [lo, hi] =
+        std::minmax_element(frames.begin(), frames.end(),
+                            [](const Frame& a, const Frame& b) { return a.number < b.number; });
+    throw UsageError("frame selection '" + selection.text() + "' keeps none of the " +
+                     std::to_string(frames.size()) + " frames (numbered " +
+                     std::to_string(lo->number) + " to " + std::to_string(hi->number) + ")");
+  }
+  return kept;
+}
+
+}  // namespace snag::seq

@@ -1,0 +1,310 @@
+// OBJ reader: every accepted form, every rejected input, ids as the file lists them.
+#include "snag/io/obj_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+
+namespace snag::io {
+namespace {
+
+using geom::Tri;
+using geom::Vec3d;
+
+std::vector<std::array<int32_t, 3>> tris(const mesh::Mesh& m) {
+  std::vector<std::array<int32_t, 3>> out;
+  for (const Tri& t : m.triangles) out.push_back({t.v[0], t.v[1], t.v[2]});
+  return out;
+}
+
+using Tris = std::vector<std::array<int32_t, 3>>;
+
+/// Parses text that must be rejected; returns the error for its message, line and path.
+InputError reject(const std::string& text) {
+  try {
+    read_obj(text, "bad.obj");
+  } catch (const InputError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return InputError("", 0, "");
+}
+
+void expect_rejected(const std::string& text, int64_t line, const std::string& must_contain) {
+  SCOPED_TRACE(text);
+  const InputError e = reject(text);
+  EXPECT_EQ(e.path(), "bad.obj");
+  EXPECT_EQ(e.line(), line) << e.what();
+  EXPECT_NE(std::string(e.what()).find(must_contain), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("bad.obj:" + std::to_string(line) + ": "), std::string::npos)
+      << e.what();
+}
+
+TEST(ObjReader, TriangleWithPlainIndices) {
+  const mesh::Mesh m = read_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj");
+  ASSERT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.positions[1], (Vec3d{1, 0, 0}));
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
+  EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0}));
+  EXPECT_EQ(m.triangle_group, (std::vector<int32_t>{-1}));
+  EXPECT_TRUE(m.group_names.empty());
+  EXPECT_EQ(m.polygon_count, 1);
+  EXPECT_FALSE(m.ids_from_assimp);
+}
+
+TEST(ObjReader, CoordinatesParsedExactly) {
+  const mesh::Mesh m =
+      read_obj("v 0.1 -2.5e-3 +7\nv 1E2 -0 .5\nv 123456789.123456789 1e-300 -4.25\n", "t.obj");
+  ASSERT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.positions[0].x, 0.1);
+  EXPECT_EQ(m.positions[0].y, -2.5e-3);
+  EXPECT_EQ(m.positions[0].z, 7.0);
+  EXPECT_EQ(m.positions[1].x, 100.0);
+  EXPECT_EQ(m.positions[1].z, 0.5);
+  EXPECT_EQ(m.positions[2].x, 123456789.123456789);
+  EXPECT_EQ(m.positions[2].y, 1e-300);
+}
+
+TEST(ObjReader, AllCornerForms) {
+  const std::string text =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+      "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n"
+      "f 1 2 3\n"
+      "f 2/1 4/2 3/3\n"
+      "f 1//1 2//1 3//1\n"
+      "f 2/1/1 4/2/1 3/3/1\n";
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {1, 3, 2}, {0, 1, 2}, {1, 3, 2}}));
+  EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1, 2, 3}));
+  EXPECT_EQ(m.polygon_count, 4);
+}
+
+TEST(ObjReader, NegativeIndicesAreRelativeToVerticesListedSoFar) {
+  const std::string text =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+      "f -3 -2 -1\n"
+      "v 1 1 0\n"
+      "f -3/-1 -1/-2 -2//-1\n";
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {1, 3, 2}}));
+}
+
+TEST(ObjReader, PolygonsAreFannedFromTheFirstCorner) {
+  const std::string text =
+      "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\n"
+      "f 1 2 3\n"
+      "f 1 2 3 4 5\n"
+      "f 5 4 3 2\n";
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {4, 3, 2}, {4, 2, 1}}));
+  EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1, 1, 1, 2, 2}));
+  EXPECT_EQ(m.polygon_count, 3);
+}
+
+TEST(ObjReader, GroupsKeptPerTriangleInOrderOfFirstUse) {
+  const std::string text =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+      "f 1 2 3\n"
+      "o cloth\n"
+      "g unused\n"
+      "g front panel  \r\n"
+      "f 1 2 3 4\n"
+      "g back\n"
+      "f 2 4 3\n"
+      "g front panel\n"
+      "f 1 2 3\n"
+      "g\n"
+      "f 1 2 3\n"
+      "o body\n"
+      "f 1 2 3\n";
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  EXPECT_EQ(m.group_names, (std::vector<std::string>{"front panel", "back", "body"}));
+  EXPECT_EQ(m.triangle_group, (std::vector<int32_t>{-1, 0, 0, 1, 0, -1, 2}));
+}
+
+TEST(ObjReader, SkipsCommentsBlankLinesUnknownRecordsAndCrlf) {
+  const std::string text =
+      "# exported by a simulator\r\n"
+      "mtllib cloth.mtl\r\n"
+      "\r\n"
+      "   \t\r\n"
+      "v 0 0 0 1.0\r\n"             // with w
+      "v 1 0 0 0.5 0.25 0.125\r\n"  // with a vertex color
+      "  v   0\t1   0  \r\n"        // leading blanks, tabs
+      "vt 0 0\r\nvn 0 0 1\r\nvp 0.5\r\n"
+      "ny 0 0 1\r\nnv 4\r\n"
+      "s off\r\nusemtl silk\r\nl 1 2\r\np 1\r\n"
+      "curv 0 1 2\r\n"
+      "f 1 2 3 # trailing comment\r\n"
+      "# f 9 9 9\r\n"
+      "f 3 2 1";  // no final newline
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  ASSERT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.positions[2], (Vec3d{0, 1, 0}));
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {2, 1, 0}}));
+}
+
+TEST(ObjReader, EmptyTextIsAnEmptyMesh) {
+  const mesh::Mesh m = read_obj("", "t.obj");
+  EXPECT_TRUE(m.positions.empty());
+  EXPECT_TRUE(m.triangles.empty());
+  EXPECT_EQ(m.polygon_count, 0);
+}
+
+TEST(ObjReader, FacesMayNameVerticesListedLater) {
+  const mesh::Mesh m = read_obj("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", "t.obj");
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
+}
+
+TEST(ObjReader, RejectsIndexZero) {
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 0 3\n", 4, "'0'");
+}
+
+TEST(ObjReader, RejectsIndexOutOfRange) {
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 4\n", 5, "'4' is out of range");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4/1/1\nv 0 0 1\nf 1 2 9\n", 7, "'9'");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", 4, "'-4'");
+  expect_rejected("v 0 0 0\nf 1 2 99999999999999999999\n", 2, "out of range");
+}
+
+TEST(ObjReader, RejectsNonNumbers) {
+  expect_rejected("v 0 0 0\nv 1 zero 0\n", 2, "'zero'");
+  expect_rejected("v 0 0 0\nv 1 0.5.5 0\n", 2, "'0.5.5'");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 4, "'x'");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2.5 3\n", 4, "'2.5'");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3a\n", 4, "'3a'");
+}
+
+TEST(ObjReader, RejectsNanAndInf) {
+  expect_rejected("v 0 0 0\nv nan 0 0\n", 2, "'nan'");
+  expect_rejected("v 0 0 0\n\nv 0 inf 0\n", 3, "'inf'");
+  expect_rejected("v 0 0 -Infinity\n", 1, "not finite");
+  expect_rejected("v 0 0 1e999\n", 1, "'1e999'");
+}
+
+TEST(ObjReader, RejectsMissingCoordinates) {
+  expect_rejected("v 0 0\n", 1, "expected 3 numbers");
+  expect_rejected("v 0 0 0\nv\r\n", 2, "expected 3 numbers");
+}
+
+TEST(ObjReader, RejectsFacesWithFewerThanThreeCorners) {
+  expect_rejected("v 0 0 0\nv 1 0 0\nf 1 2\n", 3, "2 corners; expected at least 3");
+  expect_rejected("v 0 0 0\nf\n", 2, "0 corners");
+}
+
+TEST(ObjReader, LineNumbersCountCrlfAndSkippedLines) {
+  expect_rejected("# c\r\nvt 0 0\r\n\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 0\r\n", 7, "is 0");
+}
+
+TEST(ObjReader, LongTokensAreShortenedInMessages) {
+  const InputError e = reject("v 0 0 " + std::string(500, 'a') + "\n");
+  EXPECT_LT(std::string(e.what()).size(), 200u) << e.what();
+}
+
+// A grid of quads written as an exporter would: the reader must be fast on it.
+std::string make_grid_obj(int n) {
+  std::string text;
+  char buf[128];
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      std::snprintf(buf, sizeof buf, "v %.7f %.7f %.7f\n", i * 0.0123456789, j * 0.0123456789,
+                    0.001 * ((i * 7 + j * 13) % 17));
+      text += buf;
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i + 1;
+      std::snprintf(buf, sizeof buf, "f %d %d %d\nf %d %d %d\n", a, a + 1, a + n + 2, a, a + n + 2,
+                    a + n + 1);
+      text += buf;
+    }
+  }
+  return text;
+}
+
+TEST(ObjReader, ReadsAGridWithTheFilesIds) {
+  const int n = 20;
+  const mesh::Mesh m = read_obj(make_grid_obj(n), "grid.obj");
+  ASSERT_EQ(m.positions.size(), static_cast<size_t>((n + 1) * (n + 1)));
+  ASSERT_EQ(m.triangles.size(), static_cast<size_t>(2 * n * n));
+  EXPECT_EQ(m.triangles[5].v[0], 2);
+  EXPECT_EQ(m.triangles[5].v[2], 2 + n + 1);
+  EXPECT_EQ(m.positions[n + 2].x, 0.0123457);
+  EXPECT_EQ(m.source_polygon.back(), 2 * n * n - 1);
+}
+
+// Not a benchmark: a generous bound that only a badly slow reader (iostreams, per-line
+// allocation) would miss, on the 36K-triangle frame size.
+TEST(ObjReader, ThirtySixThousandTrianglesReadQuickly) {
+  const std::string text = make_grid_obj(134);  // 35,912 triangles, 18,225 vertices
+  double best = 1e9;
+  for (int rep = 0; rep < 5; ++rep) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const mesh::Mesh m = read_obj(text, "grid.obj");
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    best = std::min(best, s);
+    ASSERT_EQ(m.triangles.size(), 35912u);
+  }
+  RecordProperty("megabytes_per_second", static_cast<int>(text.size() / best / 1e6));
+  EXPECT_LT(best, 0.050) << text.size() / best / 1e6 << " MB/s";
+}
+
+TEST(ReadMesh, DispatchesByExtensionCaseInsensitively) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("snag_obj_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "frame.0001.OBJ";
+  std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const mesh::Mesh m = read_mesh(path);
+  EXPECT_EQ(m.triangles.size(), 1u);
+  EXPECT_FALSE(m.ids_from_assimp);
+  // Errors name the file as it was given.
+  std::ofstream(dir / "bad.obj") << "v 0 0 0\nf 1 1\n";
+  try {
+    read_mesh(dir / "bad.obj");
+    ADD_FAILURE() << "accepted a 2-corner face";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.path(), (dir / "bad.obj").string());
+    EXPECT_EQ(e.line(), 2);
+  }
+  EXPECT_THROW(read_mesh(dir / "missing.obj"), InputError);
+  EXPECT_THROW(read_mesh(dir), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ReadMesh, OtherFormatsGoThroughAssimpAndSaySo) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("snag_stl_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "two.stl";
+  // Two triangles sharing an edge: joined vertices make 4 positions, not 6.
+  std::ofstream(path) << "solid t\n"
+                         "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 "
+                         "0\nendloop\nendfacet\n"
+                         "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 "
+                         "0\nendloop\nendfacet\n"
+                         "endsolid t\n";
+  const mesh::Mesh m = read_mesh(path);
+  EXPECT_TRUE(m.ids_from_assimp);
+  ASSERT_EQ(m.triangles.size(), 2u);
+  EXPECT_EQ(m.positions.size(), 4u);
+  EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1}));
+  EXPECT_EQ(m.triangle_group.size(), 2u);
+  std::ofstream(dir / "junk.stl") << "this is not a mesh";
+  EXPECT_THROW(read_mesh(dir / "junk.stl"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace snag::io

@@ -1,0 +1,261 @@
+// Sequence resolution (files, directories, frame tokens, globs) and --frames selections.
+#include "snag/seq/sequence.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "snag/error.h"
+
+namespace snag::seq {
+namespace {
+namespace fs = std::filesystem;
+
+/// A fresh directory of empty files for one test, removed afterwards.
+class SequenceDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ =
+        fs::temp_directory_path() / ("snag_seq_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void touch(std::initializer_list<std::string> names) {
+    for (const std::string& n : names) std::ofstream(dir_ / n) << "v 0 0 0\n";
+  }
+  std::string at(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// (number, file name) pairs of a resolved sequence.
+  static std::vector<std::pair<int64_t, std::string>> names(const std::vector<Frame>& frames) {
+    std::vector<std::pair<int64_t, std::string>> out;
+    for (const Frame& f : frames) out.emplace_back(f.number, f.path.filename().string());
+    return out;
+  }
+  using Names = std::vector<std::pair<int64_t, std::string>>;
+
+  fs::path dir_;
+};
+
+TEST_F(SequenceDir, SingleFileTakesTheDigitsOfItsName) {
+  touch({"dress.0042.obj", "body.obj"});
+  EXPECT_EQ(names(resolve_sequence(at("dress.0042.obj"))), (Names{{42, "dress.0042.obj"}}));
+  EXPECT_EQ(names(resolve_sequence(at("body.obj"))), (Names{{0, "body.obj"}}));
+  EXPECT_EQ(resolve_sequence(at("body.obj"))[0].path, dir_ / "body.obj");
+}
+
+TEST_F(SequenceDir, DirectoryListsObjAndPlyFilesInNumericOrder) {
+  touch({"f100.obj", "f2.obj", "f10.OBJ", "f3.ply", "notes.txt", "f7.obj.bak", "cache_v2_f1.Ply"});
+  fs::create_directories(dir_ / "sub.obj");
+  EXPECT_EQ(names(resolve_sequence(dir_.string())), (Names{{1, "cache_v2_f1.Ply"},
+                                                           {2, "f2.obj"},
+                                                           {3, "f3.ply"},
+                                                           {10, "f10.OBJ"},
+                                                           {100, "f100.obj"}}));
+}
+
+TEST_F(SequenceDir, DirectoryWithTwoFilesOfOneFrameIsAnError) {
+  touch({"cloth.0001.obj", "body.0001.obj"});
+  try {
+    resolve_sequence(dir_.string());
+    FAIL() << "accepted two files for frame 1";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.path(), dir_.string());
+    EXPECT_NE(std::string(e.what()).find("two files have frame number 1"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(SequenceDir, DirectoryWithoutFramesIsAnError) {
+  touch({"readme.txt"});
+  EXPECT_THROW(resolve_sequence(dir_.string()), InputError);
+}
+
+TEST_F(SequenceDir, PrintfPatternMatchesWhatPrintfWrites) {
+  touch({"dress.0001.obj", "dress.0010.obj", "dress.12345.obj", "dress.001.obj", "dress.00002.obj",
+         "dress.0003.ply", "body.0001.obj", "dress.-001.obj", "dress.00x1.obj"});
+  EXPECT_EQ(names(resolve_sequence(at("dress.%04d.obj"))), (Names{{-1, "dress.-001.obj"},
+                                                                  {1, "dress.0001.obj"},
+                                                                  {10, "dress.0010.obj"},
+                                                                  {12345, "dress.12345.obj"}}));
+  // printf("%03d", 10) is "010": "0010" is not frame 10 at width 3.
+  EXPECT_EQ(names(resolve_sequence(at("dress.%03d.obj"))),
+            (Names{{1, "dress.001.obj"}, {12345, "dress.12345.obj"}}));
+}
+
+TEST_F(SequenceDir, UnpaddedTokensMatchNumbersWithoutLeadingZeros) {
+  touch({"s1.obj", "s20.obj", "s0.obj", "s007.obj", "s.obj"});
+  const Names unpadded{{0, "s0.obj"}, {1, "s1.obj"}, {20, "s20.obj"}};
+  EXPECT_EQ(names(resolve_sequence(at("s%d.obj"))), unpadded);
+  EXPECT_EQ(names(resolve_sequence(at("s$F.obj"))), unpadded);
+  EXPECT_EQ(names(resolve_sequence(at("s#.obj"))), unpadded);
+  EXPECT_EQ(names(resolve_sequence(at("s@.obj"))), unpadded);
+}
+
+TEST_F(SequenceDir, HashAtAndHoudiniTokensGiveTheWidth) {
+  touch({"c_0001.ply", "c_0002.ply", "c_003.ply", "c_1000.ply"});
+  const Names four{{1, "c_0001.ply"}, {2, "c_0002.ply"}, {1000, "c_1000.ply"}};
+  EXPECT_EQ(names(resolve_sequence(at("c_####.ply"))), four);
+  EXPECT_EQ(names(resolve_sequence(at("c_@@@@.ply"))), four);
+  EXPECT_EQ(names(resolve_sequence(at("c_$F4.ply"))), four);
+  EXPECT_EQ(names(resolve_sequence(at("c_%04d.ply"))), four);
+  EXPECT_EQ(names(resolve_sequence(at("c_###.ply"))),
+            (Names{{3, "c_003.ply"}, {1000, "c_1000.ply"}}));
+}
+
+TEST_F(SequenceDir, PatternRelativeToTheWorkingDirectory) {
+  touch({"a.0001.obj", "a.0002.obj"});
+  const fs::path old = fs::current_path();
+  fs::current_path(dir_);
+  std::vector<Frame> frames;
+  EXPECT_NO_THROW(frames = resolve_sequence("a.####.obj"));
+  fs::current_path(old);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[1].path, fs::path("a.0002.obj"));
+}
+
+TEST_F(SequenceDir, GlobsNumberFilesByTheirLastDigits) {
+  touch({"take2_f9.obj", "take2_f10.obj", "take2_f11.ply", "take3_f1.obj", "other.obj"});
+  EXPECT_EQ(names(resolve_sequence(at("take2_*.obj"))),
+            (Names{{9, "take2_f9.obj"}, {10, "take2_f10.obj"}}));
+  EXPECT_EQ(names(resolve_sequence(at("take?_f1*"))),
+            (Names{{1, "take3_f1.obj"}, {10, "take2_f10.obj"}, {11, "take2_f11.ply"}}));
+  EXPECT_EQ(names(resolve_sequence(at("take[2]_f1[0-9].*"))),
+            (Names{{10, "take2_f10.obj"}, {11, "take2_f11.ply"}}));
+  EXPECT_EQ(names(resolve_sequence(at("take[!2]_*"))), (Names{{1, "take3_f1.obj"}}));
+  EXPECT_EQ(names(resolve_sequence(at("*f9*"))), (Names{{9, "take2_f9.obj"}}));
+}
+
+TEST_F(SequenceDir, NothingMatchedNamesThePattern) {
+  touch({"dress.001.obj"});
+  for (const std::string& spec : {at("dress.%04d.obj"), at("dress.*.ply"), at("nothing.obj")}) {
+    try {
+      resolve_sequence(spec);
+      ADD_FAILURE() << spec << " matched";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.path(), spec);
+      EXPECT_EQ(std::string(e.what()).rfind(spec + ": ", 0), 0u) << e.what();
+    }
+  }
+  EXPECT_THROW(resolve_sequence((dir_ / "missing_dir" / "f.%04d.obj").string()), InputError);
+}
+
+TEST_F(SequenceDir, BadPatternsAreUsageErrors) {
+  EXPECT_THROW(resolve_sequence(""), UsageError);
+  EXPECT_THROW(resolve_sequence(at("a.%04d.%04d.obj")), UsageError);
+  EXPECT_THROW(resolve_sequence(at("a_####_*.obj")), UsageError);
+}
+
+TEST(FrameNumber, LastRunOfDigitsInTheStem) {
+  EXPECT_EQ(frame_number_from_name("shots/sh010/dress.0042.obj"), 42);
+  EXPECT_EQ(frame_number_from_name("cloth_ball92.ply"), 92);
+  EXPECT_EQ(frame_number_from_name("v2/body.obj"), 0);
+  EXPECT_EQ(frame_number_from_name("a12b34c.ply"), 34);
+  EXPECT_EQ(frame_number_from_name("frame.obj2"), 0);  // digits of the extension do not count
+  EXPECT_THROW(frame_number_from_name("f99999999999999999999.obj"), InputError);
+}
+
+TEST(FrameSelection, DefaultSelectsEverything) {
+  const FrameSelection all;
+  EXPECT_TRUE(all.selects_all());
+  EXPECT_TRUE(all.contains(-5));
+  EXPECT_TRUE(all.contains(1000000));
+}
+
+TEST(FrameSelection, Range) {
+  const FrameSelection s = FrameSelection::parse("1-240");
+  EXPECT_FALSE(s.selects_all());
+  EXPECT_FALSE(s.contains(0));
+  EXPECT_TRUE(s.contains(1));
+  EXPECT_TRUE(s.contains(120));
+  EXPECT_TRUE(s.contains(240));
+  EXPECT_FALSE(s.contains(241));
+}
+
+TEST(FrameSelection, RangeWithStepCountsFromTheFirstFrame) {
+  const FrameSelection s = FrameSelection::parse("1-240x5");
+  std::vector<int64_t> kept;
+  for (int64_t f = -10; f <= 260; ++f)
+    if (s.contains(f)) kept.push_back(f);
+  ASSERT_EQ(kept.size(), 48u);
+  EXPECT_EQ(kept.front(), 1);
+  EXPECT_EQ(kept[1], 6);
+  EXPECT_EQ(kept.back(), 236);
+}
+
+TEST(FrameSelection, ListsSinglesBlanksAndNegatives) {
+  const FrameSelection s = FrameSelection::parse(" 1-10, 20-30 ,7,-12--10,-3");
+  for (int64_t f : {1, 5, 10, 20, 30, 7, -12, -11, -10, -3}) EXPECT_TRUE(s.contains(f)) << f;
+  for (int64_t f : {0, 11, 19, 31, -9, -13, -4, -2}) EXPECT_FALSE(s.contains(f)) << f;
+  EXPECT_EQ(s.text(), " 1-10, 20-30 ,7,-12--10,-3");
+  const FrameSelection one = FrameSelection::parse("7");
+  EXPECT_TRUE(one.contains(7));
+  EXPECT_FALSE(one.contains(8));
+}
+
+TEST(FrameSelection, HugeRangesDoNotOverflow) {
+  const FrameSelection s = FrameSelection::parse("-9223372036854775807-9223372036854775807x2");
+  EXPECT_TRUE(s.contains(-9223372036854775807));
+  EXPECT_TRUE(s.contains(1));
+  EXPECT_FALSE(s.contains(0));
+}
+
+TEST(FrameSelection, BadSelectionsAreUsageErrorsQuotingTheItem) {
+  struct Case {
+    const char* text;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"", "empty item"},
+      {"1,,3", "empty item"},
+      {"1-10,", "empty item"},
+      {"a", "'a'"},
+      {"1-", "'1-'"},
+      {"1-x", "'1-x'"},
+      {"10-1", "'10-1' ends before it starts"},
+      {"1-10x0", "step 0"},
+      {"1-10x-2", "step -2"},
+      {"1-10y", "unexpected 'y'"},
+      {"1 2", "unexpected ' 2'"},
+      {"1-10x", "'1-10x'"},
+      {"5x2", "unexpected 'x2'"},
+      {"99999999999999999999", "bad number"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    try {
+      FrameSelection::parse(c.text);
+      ADD_FAILURE() << "accepted";
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SelectFrames, KeepsTheSelectedFramesInOrder) {
+  const std::vector<Frame> frames = {{1, "a1.obj"}, {2, "a2.obj"}, {5, "a5.obj"}, {9, "a9.obj"}};
+  const std::vector<Frame> kept = select_frames(frames, FrameSelection::parse("2-9x3,1"));
+  EXPECT_EQ(kept, (std::vector<Frame>{{1, "a1.obj"}, {2, "a2.obj"}, {5, "a5.obj"}}));
+  EXPECT_EQ(select_frames(frames, FrameSelection()), frames);
+}
+
+TEST(SelectFrames, SelectingNothingIsAUsageError) {
+  const std::vector<Frame> frames = {{1, "a1.obj"}, {2, "a2.obj"}};
+  try {
+    select_frames(frames, FrameSelection::parse("300-400"));
+    FAIL() << "selected nothing without an error";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("'300-400' keeps none of the 2 frames (numbered 1 to 2)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace snag::seq
