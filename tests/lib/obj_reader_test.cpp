@@ -14,6 +14,7 @@
 
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
+#include "test_paths.h"
 
 namespace snag::io {
 namespace {
@@ -283,17 +284,30 @@ TEST(ReadMesh, DispatchesByExtensionCaseInsensitively) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ReadMesh, StlFilesOfSharedDataComeBackWelded) {
+  const std::filesystem::path data = snag::test::data_dir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent (set SNAG_DATA_DIR to run this test)";
+  const mesh::Mesh cubes = read_mesh(data / "arrangements/three_cubes.stl");
+  EXPECT_TRUE(cubes.ids_from_assimp);
+  EXPECT_EQ(cubes.triangles.size(), 36u);
+  EXPECT_EQ(cubes.positions.size(), 24u);  // 3 cubes of 8 corners
+  const mesh::Mesh spheres = read_mesh(data / "arrangements/two_spheres.stl");
+  EXPECT_EQ(spheres.triangles.size(), 1600u);
+  EXPECT_EQ(spheres.positions.size(), 804u);  // two closed spheres: V = F/2 + 2 each
+}
+
 TEST(ReadMesh, OtherFormatsGoThroughAssimpAndSaySo) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("snag_stl_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto path = dir / "two.stl";
-  // Two triangles sharing an edge: joined vertices make 4 positions, not 6.
+  // Two triangles sharing an edge, folded (different facet normals): joined vertices make 4
+  // positions, not 6.
   std::ofstream(path) << "solid t\n"
-                         "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 "
-                         "0\nendloop\nendfacet\n"
-                         "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 "
-                         "0\nendloop\nendfacet\n"
+                         "facet normal 0 -1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                         "vertex 0 0 1\nendloop\nendfacet\n"
+                         "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 0 1 0\n"
+                         "vertex 0 0 0\nendloop\nendfacet\n"
                          "endsolid t\n";
   const mesh::Mesh m = read_mesh(path);
   EXPECT_TRUE(m.ids_from_assimp);
@@ -301,6 +315,14 @@ TEST(ReadMesh, OtherFormatsGoThroughAssimpAndSaySo) {
   EXPECT_EQ(m.positions.size(), 4u);
   EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1}));
   EXPECT_EQ(m.triangle_group.size(), 2u);
+  // The triangles keep the file's corners (renumbered by assimp): one in y = 0, one in z = 0.
+  int in_y0 = 0, in_z0 = 0;
+  for (const Tri& t : m.triangles) {
+    in_y0 += m.positions[t.v[0]].y == 0 && m.positions[t.v[1]].y == 0 && m.positions[t.v[2]].y == 0;
+    in_z0 += m.positions[t.v[0]].z == 0 && m.positions[t.v[1]].z == 0 && m.positions[t.v[2]].z == 0;
+  }
+  EXPECT_EQ(in_y0, 1);
+  EXPECT_EQ(in_z0, 1);
   std::ofstream(dir / "junk.stl") << "this is not a mesh";
   EXPECT_THROW(read_mesh(dir / "junk.stl"), InputError);
   std::filesystem::remove_all(dir);

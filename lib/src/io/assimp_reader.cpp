@@ -2,6 +2,7 @@
 // ids of these meshes are assimp's; the mesh says so and the reports repeat it.
 #include "snag/io/assimp_reader.h"
 
+#include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -59,8 +60,15 @@ struct SceneFlattener {
 
 mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   Assimp::Importer importer;
+  // Joining compares every vertex attribute, not only the position: an STL corner carries its
+  // facet's normal, so without removing normals (and UVs, colors, tangents, which split
+  // vertices on seams the same way) a folded STL would stay a triangle soup.
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
+                              aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                  aiComponent_COLORS | aiComponent_TEXCOORDS);
   const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_JoinIdenticalVertices | aiProcess_Triangulate);
+      importer.ReadFile(path.string(), aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices |
+                                           aiProcess_Triangulate);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path.string(), 0,
                      std::string("assimp cannot read the file: ") + importer.GetErrorString());
