@@ -361,6 +361,24 @@ TEST(PlyReader, RejectsTruncatedAscii) {
   expect_contains(e, "file ends inside face 1 (of 2)");
 }
 
+TEST(PlyReader, RejectsNegativeListCounts) {
+  for (Enc enc : {Enc::ascii, Enc::le, Enc::be}) {
+    SCOPED_TRACE(format_name(enc));
+    Body b(enc);
+    for (int i = 0; i < 3; ++i) b.put<float>(1.f * i).put<float>(0.f).put<float>(0.f).end();
+    b.put<int8_t>(-2).put<int32_t>(0).end();  // a skipped list with a negative count
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).end();
+    const std::string text =
+        header(enc,
+               "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 1\nproperty list char int texcoord\n"
+               "property list uchar int vertex_indices\n") +
+        b.str();
+    const InputError e = reject(text);
+    expect_contains(e, "'texcoord' of face 0 (of 1) has count -2");
+  }
+}
+
 TEST(PlyReader, RejectsAsciiNonNumbers) {
   std::string text = square(Enc::ascii);
   text.replace(text.find("end_header\n") + 11, 1, "zero");

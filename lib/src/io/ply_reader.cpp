@@ -595,9 +595,7 @@ class AsciiBody {
           read_face(el, i);
         } else {
           for (const Property& prop : el.properties) {
-            const int64_t n = prop.is_list ? next_integer(el, i, prop, "list count") : 1;
-            if (n < 0)
-              fail("list count " + std::to_string(n) + " is negative; expected a count >= 0");
+            const int64_t n = prop.is_list ? next_count(el, i, prop) : 1;
             for (int64_t k = 0; k < n; ++k) next_token(el, i);
           }
         }
@@ -633,12 +631,21 @@ class AsciiBody {
     return v;
   }
 
+  int64_t next_count(const Element& el, int64_t i, const Property& prop) {
+    const int64_t n = next_integer(el, i, prop, "list count");
+    if (n < 0) {
+      fail("list " + quote(prop.name) + " of " + record_name(el, i) + " has count " +
+           std::to_string(n) + "; expected a count >= 0");
+    }
+    return n;
+  }
+
   void read_vertex(const Element& el, int64_t i) {
     double xyz[3] = {0, 0, 0};
     for (size_t k = 0; k < el.properties.size(); ++k) {
       const Property& prop = el.properties[k];
       if (prop.is_list) {
-        const int64_t n = next_integer(el, i, prop, "list count");
+        const int64_t n = next_count(el, i, prop);
         for (int64_t c = 0; c < n; ++c) next_token(el, i);
         continue;
       }
@@ -665,7 +672,7 @@ class AsciiBody {
     for (size_t k = 0; k < el.properties.size(); ++k) {
       const Property& prop = el.properties[k];
       if (static_cast<int>(k) != plan_.indices) {
-        const int64_t n = prop.is_list ? next_integer(el, i, prop, "list count") : 1;
+        const int64_t n = prop.is_list ? next_count(el, i, prop) : 1;
         for (int64_t c = 0; c < n; ++c) next_token(el, i);
         continue;
       }
