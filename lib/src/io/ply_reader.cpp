@@ -511,23 +511,38 @@ class BinaryBody {
         }
         p_ += count_size;
         need(el, i, n * index_size);
+        if (n == 3) {
+          // Triangles, nearly every face of a simulation frame: no corner buffer, no fan loop.
+          int32_t t[3];
+          for (int c = 0; c < 3; ++c, p_ += index_size) {
+            const int64_t v = load_int(p_, list.type);
+            if (v < 0 || v >= vertex_count) bad_index(el, i, c, v, vertex_count);
+            t[c] = static_cast<int32_t>(v);
+          }
+          mesh_.triangles.push_back({{t[0], t[1], t[2]}});
+          mesh_.source_polygon.push_back(static_cast<int32_t>(i));
+          mesh_.triangle_group.push_back(-1);
+          continue;
+        }
         corners_.clear();
         for (int64_t c = 0; c < n; ++c, p_ += index_size) {
           const int64_t v = load_int(p_, list.type);
-          if (v < 0 || v >= vertex_count) {
-            throw InputError(name_, 0,
-                             "corner " + std::to_string(c) + " of " + record_name(el, i) +
-                                 " is vertex " + std::to_string(v) + "; expected 0.." +
-                                 std::to_string(vertex_count - 1) + " (" +
-                                 std::to_string(vertex_count) + " vertices)",
-                             offset(p_));
-          }
+          if (v < 0 || v >= vertex_count) bad_index(el, i, c, v, vertex_count);
           corners_.push_back(static_cast<int32_t>(v));
         }
         add_polygon(mesh_, corners_, static_cast<int32_t>(i));
       }
     }
     mesh_.polygon_count = el.count;
+  }
+
+  [[noreturn]] [[gnu::noinline]] void bad_index(const Element& el, int64_t i, int64_t c, int64_t v,
+                                                int64_t vertex_count) const {
+    throw InputError(name_, 0,
+                     "corner " + std::to_string(c) + " of " + record_name(el, i) + " is vertex " +
+                         std::to_string(v) + "; expected 0.." + std::to_string(vertex_count - 1) +
+                         " (" + std::to_string(vertex_count) + " vertices)",
+                     offset(p_));
   }
 
   void skip_element(const Element& el) {
