@@ -92,8 +92,8 @@ std::string find_generator(const BenchOptions& o) {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    for (const fs::path& candidate :
-         {self.parent_path() / "snag-cloth", self.parent_path().parent_path() / "samples" / "snag-cloth"})
+    for (const fs::path& candidate : {self.parent_path() / "snag-cloth",
+                                      self.parent_path().parent_path() / "samples" / "snag-cloth"})
       if (fs::exists(candidate, ec)) return candidate.string();
   }
   return "snag-cloth";
@@ -146,7 +146,8 @@ Row run_case(const Case& c, const BenchOptions& o) {
   if (meshes.empty()) throw InputError(c.name, 0, "no frames");
   const mesh::Mesh& first = meshes.front();
   for (const mesh::Mesh& m : meshes)
-    if (m.positions.size() != first.positions.size() || m.triangles.size() != first.triangles.size())
+    if (m.positions.size() != first.positions.size() ||
+        m.triangles.size() != first.triangles.size())
       throw InputError(c.name, 0, "frames of a benchmark case must share one topology");
   const int32_t vertices = static_cast<int32_t>(first.positions.size());
 
@@ -158,8 +159,10 @@ Row run_case(const Case& c, const BenchOptions& o) {
   // Two checkers over the same frames: one refits (the steady state of a sequence), one
   // rebuilds every frame (the build time per frame).
   auto resolver = validators::make_cgal_resolver();
-  detect::Checker refitting(make_backend("cpu", o.threads), resolver, {detect::RebuildPolicy::never});
-  detect::Checker rebuilding(make_backend("cpu", o.threads), resolver, {detect::RebuildPolicy::always});
+  detect::Checker refitting(make_backend("cpu", o.threads), resolver,
+                            {detect::RebuildPolicy::never});
+  detect::Checker rebuilding(make_backend("cpu", o.threads), resolver,
+                             {detect::RebuildPolicy::always});
   refitting.set_triangles(first.triangles, vertices);
   rebuilding.set_triangles(first.triangles, vertices);
 
@@ -176,7 +179,8 @@ Row run_case(const Case& c, const BenchOptions& o) {
     if (pair_ids(r) != reference || pair_ids(built) != reference) {
       row.same = false;
       row.note = "frame " + std::to_string(it % meshes.size()) + ": snag " +
-                 std::to_string(r.pairs.size()) + " pairs, CGAL " + std::to_string(reference.size());
+                 std::to_string(r.pairs.size()) + " pairs, CGAL " +
+                 std::to_string(reference.size());
     }
     if (it < o.warmup) continue;
     build.push_back(built.times.build);
@@ -200,8 +204,9 @@ Row run_case(const Case& c, const BenchOptions& o) {
 void print_table(const std::vector<Row>& rows, int threads) {
   std::printf("snag bench cpu: %d threads; medians over the timed frames, milliseconds per frame\n",
               threads);
-  std::printf("snag total = refit + traverse + exact/classify (the tree is built once per "
-              "topology; build is the time of one rebuild)\n\n");
+  std::printf(
+      "snag total = refit + traverse + exact/classify (the tree is built once per "
+      "topology; build is the time of one rebuild)\n\n");
   std::printf("%-22s %9s %6s %9s %9s %9s %9s %9s %9s %9s %8s %5s\n", "case", "triangles", "frames",
               "build", "refit", "traverse", "exact", "total", "CGAL", "CGAL/snag", "pairs", "same");
   for (const Row& r : rows) {
@@ -239,7 +244,8 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
                   "The shared data folder; its scalable-ccd/cloth-ball frames are a case when "
                   "present (default: $SNAG_DATA_DIR, else the one known at build time)")
       ->type_name("DIR");
-  cpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")->type_name("SEQUENCE");
+  cpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")
+      ->type_name("SEQUENCE");
   cpu->add_option("--generator", o.generator,
                   "The snag-cloth sample generator (default: beside snag, in the build tree, "
                   "or on PATH)")
@@ -259,7 +265,8 @@ int run_bench_cpu(const BenchOptions& o) {
   if (data.empty()) {
     if (const char* env = std::getenv("SNAG_DATA_DIR"); env && *env) data = env;
 #ifdef SNAG_DATA_DIR_DEFAULT
-    else data = SNAG_DATA_DIR_DEFAULT;
+    else
+      data = SNAG_DATA_DIR_DEFAULT;
 #endif
   }
   const fs::path ball = data / "scalable-ccd" / "cloth-ball";

@@ -47,7 +47,8 @@ std::vector<seq::Frame> resolve_frames(const CheckOptions& options) {
 
 /// The triangles the checker sees: the file's, with each corner replaced by its weld
 /// representative when welding (geometry then comes from the representative's position).
-std::vector<geom::Tri> welded_triangles(const mesh::Mesh& mesh, std::span<const int32_t> representative) {
+std::vector<geom::Tri> welded_triangles(const mesh::Mesh& mesh,
+                                        std::span<const int32_t> representative) {
   std::vector<geom::Tri> triangles = mesh.triangles;
   if (representative.empty()) return triangles;
   for (geom::Tri& t : triangles)
@@ -68,8 +69,8 @@ std::string frame_note(const report::FrameRecord& r) {
   if (r.pairs.empty()) {
     note += "clean";
   } else {
-    note += std::to_string(r.crossing_count()) + " crossing, " + std::to_string(r.touching_count()) +
-            " touching";
+    note += std::to_string(r.crossing_count()) + " crossing, " +
+            std::to_string(r.touching_count()) + " touching";
   }
   if (!r.degenerate.empty()) note += ", " + std::to_string(r.degenerate.size()) + " degenerate";
   if (r.topology_changed) note += " (topology changed)";
@@ -144,9 +145,11 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("FACTOR")
       ->check(CLI::Range(1.0, 1e9))
       ->capture_default_str();
-  cmd->add_option("--backend", o.backend, "Detection backend: auto, cpu (cuda: not in this version)")
+  cmd->add_option("--backend", o.backend,
+                  "Detection backend: auto, cpu (cuda: not in this version)")
       ->type_name("NAME")
-      ->check(CLI::IsMember(std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))
+      ->check(CLI::IsMember(
+          std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))
       ->capture_default_str();
   cmd->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
       ->type_name("N")
@@ -164,7 +167,8 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
 int run_check(const CheckOptions& o) {
   const auto started = Clock::now();
   const auto fail_on = report::parse_fail_on(o.fail_on);
-  if (!fail_on) throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
+  if (!fail_on)
+    throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
   if (o.weld && !(*o.weld >= 0)) throw UsageError("--weld: TOL must be a number >= 0");
 
   const std::vector<seq::Frame> frames = resolve_frames(o);
@@ -194,8 +198,8 @@ int run_check(const CheckOptions& o) {
   rep.frames.reserve(frames.size());
 
   Progress progress(static_cast<int64_t>(frames.size()), o.quiet);
-  std::vector<geom::Tri> file_triangles;   // the current topology, as the file lists it
-  std::vector<int32_t> representative;     // weld representative per vertex (empty: no weld)
+  std::vector<geom::Tri> file_triangles;  // the current topology, as the file lists it
+  std::vector<int32_t> representative;    // weld representative per vertex (empty: no weld)
   int32_t vertex_count = 0;
   std::string first_file;
   bool any_assimp = false;
@@ -227,7 +231,8 @@ int run_check(const CheckOptions& o) {
       if (o.weld) {
         representative = mesh::weld_representatives(mesh.positions, *o.weld);
         int64_t welded = 0;
-        for (size_t v = 0; v < representative.size(); ++v) welded += representative[v] != static_cast<int32_t>(v);
+        for (size_t v = 0; v < representative.size(); ++v)
+          welded += representative[v] != static_cast<int32_t>(v);
         if (i == 0) rep.inputs.welded_vertices = welded;
       } else if (i == 0) {
         const int64_t coincident = mesh::count_coincident_vertices(mesh.positions);

@@ -13,9 +13,10 @@
 #include "snag/report/write.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"snag finds where a cloth animation goes through itself: every intersecting "
-               "triangle pair of every frame, labelled crossing or touching.",
-               "snag"};
+  CLI::App app{
+      "snag finds where a cloth animation goes through itself: every intersecting "
+      "triangle pair of every frame, labelled crossing or touching.",
+      "snag"};
   try {
     app.set_version_flag("--version", SNAG_VERSION);
     app.require_subcommand(1, 1);

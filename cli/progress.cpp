@@ -10,7 +10,9 @@ namespace snag::cli {
 Progress::Progress(int64_t total, bool quiet)
     : total_(total), quiet_(quiet), bar_(!quiet && ::isatty(STDERR_FILENO) == 1) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::update(int64_t done, const std::string& note) {
   if (quiet_) return;

@@ -21,8 +21,7 @@ namespace fs = std::filesystem;
 /// A quad (polygon 0: triangles (0,1,2) and (0,2,3) in the z = 0 plane) and a triangle B
 /// (polygon 1) standing across the quad's second triangle: exactly one crossing pair. The quad's
 /// two triangles share an edge and lie flat, side by side: not a pair.
-constexpr const char* quad_vertices =
-    "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\n";
+constexpr const char* quad_vertices = "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\n";
 constexpr const char* b_crossing = "v 1 3 -1\nv 1 3 1\nv 0.6 3.3 0\n";
 constexpr const char* b_away = "v 11 3 -1\nv 11 3 1\nv 10.6 3.3 0\n";
 
@@ -30,8 +29,8 @@ constexpr const char* b_away = "v 11 3 -1\nv 11 3 1\nv 10.6 3.3 0\n";
 /// pair is now (0, 2). Frame 3: same faces as frame 2, B moved away: clean.
 fs::path write_hand_built_sequence(const fs::path& dir) {
   fs::create_directories(dir);
-  write_text(dir / "f.0001.obj", std::string("# frame 1\n") + quad_vertices + b_crossing +
-                                     "f 1 2 3 4\nf 5 6 7\n");
+  write_text(dir / "f.0001.obj",
+             std::string("# frame 1\n") + quad_vertices + b_crossing + "f 1 2 3 4\nf 5 6 7\n");
   write_text(dir / "f.0002.obj", std::string(quad_vertices) + b_crossing + "f 5 6 7\nf 1 2 3 4\n");
   write_text(dir / "f.0003.obj", std::string(quad_vertices) + b_away + "f 5 6 7\nf 1 2 3 4\n");
   return dir;
@@ -41,7 +40,8 @@ std::string without_column(const std::string& csv, const std::string& column) {
   const auto rows = parse_csv(csv);
   if (rows.empty()) return {};
   const auto it = std::find(rows[0].begin(), rows[0].end(), column);
-  const size_t skip = it == rows[0].end() ? rows[0].size() : static_cast<size_t>(it - rows[0].begin());
+  const size_t skip =
+      it == rows[0].end() ? rows[0].size() : static_cast<size_t>(it - rows[0].begin());
   std::string out;
   for (const auto& row : rows) {
     bool first = true;
@@ -55,7 +55,9 @@ std::string without_column(const std::string& csv, const std::string& column) {
   return out;
 }
 
-std::string context(const RunResult& r) { return "stdout:\n" + r.out + "\nstderr:\n" + r.err; }
+std::string context(const RunResult& r) {
+  return "stdout:\n" + r.out + "\nstderr:\n" + r.err;
+}
 
 TEST(CliCheck, HandBuiltSequenceReports) {
   TempDir tmp;
@@ -115,7 +117,8 @@ TEST(CliCheck, CleanSelectionExitsZero) {
   write_hand_built_sequence(tmp.path() / "seq");
   const RunResult r = run_snag({"check", "seq", "--frames", "3", "--out", "out"}, tmp.path());
   EXPECT_EQ(r.status, 0) << context(r);
-  EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), "frame,face_a,face_b,kind,poly_a,poly_b\n");
+  EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"),
+            "frame,face_a,face_b,kind,poly_a,poly_b\n");
   EXPECT_NE(r.out.find("frames checked       1\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("worst frame          none\n"), std::string::npos) << r.out;
 }
@@ -147,7 +150,8 @@ TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
   fs::create_directories(tmp.path() / "seam");
   write_text(tmp.path() / "seam" / "s.1.obj",
              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 4 6 5\n");
-  const RunResult plain = run_snag({"check", "seam", "--fail-on", "none", "--out", "a"}, tmp.path());
+  const RunResult plain =
+      run_snag({"check", "seam", "--fail-on", "none", "--out", "a"}, tmp.path());
   EXPECT_EQ(plain.status, 0) << context(plain);
   EXPECT_NE(plain.err.find("2 vertices coincide exactly"), std::string::npos) << plain.err;
   EXPECT_NE(plain.err.find("--weld"), std::string::npos) << plain.err;
@@ -156,8 +160,8 @@ TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
   const auto a = nlohmann::json::parse(read_text(tmp.path() / "a" / "report.json"));
   EXPECT_EQ(a.at("inputs").at("coincident_vertices"), 2);
 
-  const RunResult welded = run_snag({"check", "seam", "--weld", "1e-6", "--fail-on", "any", "--out", "b"},
-                                    tmp.path());
+  const RunResult welded =
+      run_snag({"check", "seam", "--weld", "1e-6", "--fail-on", "any", "--out", "b"}, tmp.path());
   EXPECT_EQ(welded.status, 0) << context(welded);
   EXPECT_EQ(welded.err.find("coincide"), std::string::npos) << welded.err;
   EXPECT_EQ(read_text(tmp.path() / "b" / "pairs.csv"), "frame,face_a,face_b,kind,poly_a,poly_b\n");
@@ -202,8 +206,10 @@ TEST(CliStatus, CudaBackendIsAClearUsageError) {
 
 TEST(CliStatus, HelpAndVersionExitZero) {
   TempDir tmp;
-  for (const std::vector<std::string>& args :
-       {std::vector<std::string>{"--help"}, {"check", "--help"}, {"bench", "cpu", "--help"}, {"--version"}}) {
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--help"},
+                                               {"check", "--help"},
+                                               {"bench", "cpu", "--help"},
+                                               {"--version"}}) {
     const RunResult r = run_snag(args, tmp.path());
     EXPECT_EQ(r.status, 0) << args[0] << "\n" << context(r);
     EXPECT_FALSE(r.out.empty());
@@ -218,7 +224,8 @@ TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {
   const RunResult r = run_snag({"check", "seq", "--out", "out"}, tmp.path());
   EXPECT_EQ(r.status, 3) << context(r);
   EXPECT_NE(r.err.find("f.0004.obj:3"), std::string::npos) << r.err;
-  if (fs::exists(tmp.path() / "out")) EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
+  if (fs::exists(tmp.path() / "out"))
+    EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
 }
 
 TEST(CliStatus, VertexCountChangeExitsThree) {
@@ -229,7 +236,8 @@ TEST(CliStatus, VertexCountChangeExitsThree) {
   EXPECT_EQ(r.status, 3) << context(r);
   EXPECT_NE(r.err.find("f.0004.obj"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("3 vertices"), std::string::npos) << r.err;
-  if (fs::exists(tmp.path() / "out")) EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
+  if (fs::exists(tmp.path() / "out"))
+    EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
 }
 
 TEST(CliStatus, MissingSequenceAndUnwritableOutExitThree) {
@@ -247,7 +255,8 @@ TEST(CliStatus, MissingSequenceAndUnwritableOutExitThree) {
 std::set<std::string> options_in(const std::string& text) {
   std::set<std::string> found;
   const std::regex option(R"((^|[\s,\[])(--[a-z][a-z-]*|-[a-zA-Z])\b)");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), option); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), option);
+       it != std::sregex_iterator(); ++it)
     found.insert((*it)[2]);
   return found;
 }
@@ -258,7 +267,8 @@ std::string man_section(const std::string& man, const std::string& heading) {
   const size_t start = man.find(".SS \"" + heading);
   if (start == std::string::npos) return {};
   size_t end = man.find("\n.S", start + 1);
-  std::string section = man.substr(start, end == std::string::npos ? std::string::npos : end - start);
+  std::string section =
+      man.substr(start, end == std::string::npos ? std::string::npos : end - start);
   return std::regex_replace(section, std::regex(R"(\\-)"), "-");
 }
 
@@ -280,7 +290,8 @@ TEST(CliHelp, AgreesWithTheManPage) {
     std::set<std::string> in_man = options_in(section);
     in_man.erase("-h");
     in_man.erase("--help");
-    EXPECT_EQ(in_help, in_man) << heading << ": `snag " << args[0] << " --help` and man/snag.1 list "
+    EXPECT_EQ(in_help, in_man) << heading << ": `snag " << args[0]
+                               << " --help` and man/snag.1 list "
                                << "different options";
   }
   // Every exit status in the man page.

@@ -41,11 +41,13 @@ class DrapeExpected : public ::testing::Test {
     frames_text_ = read_text(root_ / expected_dir / "frames.csv");
     const auto rows = parse_csv(pairs_text_);
     ASSERT_FALSE(rows.empty());
-    ASSERT_EQ(rows[0], (std::vector<std::string>{"frame", "face_a", "face_b", "kind", "poly_a", "poly_b"}));
+    ASSERT_EQ(rows[0],
+              (std::vector<std::string>{"frame", "face_a", "face_b", "kind", "poly_a", "poly_b"}));
     for (size_t i = 1; i < rows.size(); ++i) {
       ASSERT_EQ(rows[i].size(), 6u) << "pairs.csv row " << i;
-      pairs_[std::stoll(rows[i][0])].push_back({std::stoi(rows[i][1]), std::stoi(rows[i][2]), rows[i][3],
-                                                std::stoi(rows[i][4]), std::stoi(rows[i][5])});
+      pairs_[std::stoll(rows[i][0])].push_back({std::stoi(rows[i][1]), std::stoi(rows[i][2]),
+                                                rows[i][3], std::stoi(rows[i][4]),
+                                                std::stoi(rows[i][5])});
       any_crossing_ = any_crossing_ || rows[i][3] == "crossing";
     }
   }
@@ -61,7 +63,8 @@ class DrapeExpected : public ::testing::Test {
 std::string without_seconds(const std::string& csv) {
   const auto rows = parse_csv(csv);
   const auto& header = rows.at(0);
-  const size_t skip = static_cast<size_t>(std::find(header.begin(), header.end(), "seconds") - header.begin());
+  const size_t skip =
+      static_cast<size_t>(std::find(header.begin(), header.end(), "seconds") - header.begin());
   std::string out;
   for (const auto& row : rows) {
     for (size_t i = 0; i < row.size(); ++i) {
@@ -84,7 +87,8 @@ TEST_F(DrapeExpected, PairsAgreeWithCgal) {
     const mesh::Mesh mesh = io::read_mesh(frame.path);
     const auto reference = validators::cgal_self_intersections(mesh.positions, mesh.triangles);
     const auto it = pairs_.find(frame.number);
-    const std::vector<ExpectedPair> expected = it == pairs_.end() ? std::vector<ExpectedPair>{} : it->second;
+    const std::vector<ExpectedPair> expected =
+        it == pairs_.end() ? std::vector<ExpectedPair>{} : it->second;
 
     std::vector<std::pair<int32_t, int32_t>> ids;
     for (const auto& p : expected) ids.emplace_back(p.a, p.b);
@@ -114,8 +118,9 @@ TEST_F(DrapeExpected, PairsAgreeWithCgal) {
 
 TEST_F(DrapeExpected, FramesCsvAgreesWithPairsCsv) {
   const auto rows = parse_csv(frames_text_);
-  ASSERT_EQ(rows.at(0), (std::vector<std::string>{"frame", "file", "triangles", "pairs", "crossing", "touching",
-                                                   "degenerate", "uncertain", "rebuilt", "topology_changed"}));
+  ASSERT_EQ(rows.at(0),
+            (std::vector<std::string>{"frame", "file", "triangles", "pairs", "crossing", "touching",
+                                      "degenerate", "uncertain", "rebuilt", "topology_changed"}));
   const auto frames = seq::resolve_sequence((root_ / sample).string());
   ASSERT_EQ(rows.size(), frames.size() + 1);
   for (size_t i = 0; i < frames.size(); ++i) {
@@ -125,7 +130,8 @@ TEST_F(DrapeExpected, FramesCsvAgreesWithPairsCsv) {
     EXPECT_EQ(row[1], (sample / frames[i].path.filename()).string());
     const auto it = pairs_.find(frames[i].number);
     const auto& p = it == pairs_.end() ? std::vector<ExpectedPair>{} : it->second;
-    const auto crossing = std::count_if(p.begin(), p.end(), [](const ExpectedPair& e) { return e.kind == "crossing"; });
+    const auto crossing = std::count_if(p.begin(), p.end(),
+                                        [](const ExpectedPair& e) { return e.kind == "crossing"; });
     EXPECT_EQ(std::stoll(row[3]), static_cast<int64_t>(p.size())) << row[0];
     EXPECT_EQ(std::stoll(row[4]), crossing) << row[0];
     EXPECT_EQ(std::stoll(row[5]), static_cast<int64_t>(p.size()) - crossing) << row[0];
@@ -134,7 +140,8 @@ TEST_F(DrapeExpected, FramesCsvAgreesWithPairsCsv) {
 
 TEST_F(DrapeExpected, SnagReportsMatch) {
   TempDir tmp;
-  const RunResult r = run_snag({"check", sample.string(), "--out", (tmp.path() / "out").string()}, root_);
+  const RunResult r =
+      run_snag({"check", sample.string(), "--out", (tmp.path() / "out").string()}, root_);
   ASSERT_EQ(r.status, any_crossing_ ? 1 : 0) << r.err;
   EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), pairs_text_);
   EXPECT_EQ(without_seconds(read_text(tmp.path() / "out" / "frames.csv")), frames_text_);
@@ -145,11 +152,13 @@ TEST_F(DrapeExpected, SamePairsWithOneThreadAndEveryRebuildPolicy) {
   for (const std::vector<std::string>& extra :
        {std::vector<std::string>{"--threads", "1", "--rebuild", "always"},
         {"--threads", "2", "--rebuild", "never"}}) {
-    std::vector<std::string> args = {"check", sample.string(), "--quiet", "--out", (tmp.path() / "out").string()};
+    std::vector<std::string> args = {"check", sample.string(), "--quiet", "--out",
+                                     (tmp.path() / "out").string()};
     args.insert(args.end(), extra.begin(), extra.end());
     const RunResult r = run_snag(args, root_);
     ASSERT_EQ(r.status, any_crossing_ ? 1 : 0) << r.err;
-    EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), pairs_text_) << extra[1] << " " << extra[3];
+    EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), pairs_text_)
+        << extra[1] << " " << extra[3];
   }
 }
 

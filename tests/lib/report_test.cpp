@@ -91,8 +91,8 @@ class TempDir {
  public:
   TempDir() {
     std::random_device rd;
-    path_ = fs::temp_directory_path() / ("snag-report-test-" + std::to_string(::getpid()) + "-" +
-                                         std::to_string(rd()));
+    path_ = fs::temp_directory_path() /
+            ("snag-report-test-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -259,8 +259,9 @@ TEST(ReportJson, ParsesBackWithTheFields) {
   EXPECT_DOUBLE_EQ(f10.at("seconds").at("traverse").get<double>(), 0.001);
   EXPECT_DOUBLE_EQ(f10.at("seconds").at("total").get<double>(), 0.003);
   ASSERT_EQ(f10.at("pairs").size(), 3u);
-  EXPECT_EQ(f10.at("pairs").at(2),
-            (nlohmann::json{{"a", 1}, {"b", 3}, {"kind", "crossing"}, {"poly_a", 1}, {"poly_b", 2}}));
+  EXPECT_EQ(
+      f10.at("pairs").at(2),
+      (nlohmann::json{{"a", 1}, {"b", 3}, {"kind", "crossing"}, {"poly_a", 1}, {"poly_b", 2}}));
   EXPECT_TRUE(f10.at("degenerate").empty());
 
   const auto& f12 = frames.at(0);

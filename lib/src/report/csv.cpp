@@ -48,9 +48,9 @@ void write_pairs_csv(std::ostream& out, const Report& report) {
       return x->a != y->a ? x->a < y->a : x->b < y->b;
     });
     for (const Pair* p : sorted) {
-      const int n = std::snprintf(line, sizeof line, "%" PRId64 ",%d,%d,%s,%d,%d\n", f.frame, p->a,
-                                  p->b, p->kind == detect::PairKind::crossing ? "crossing" : "touching",
-                                  p->poly_a, p->poly_b);
+      const int n = std::snprintf(
+          line, sizeof line, "%" PRId64 ",%d,%d,%s,%d,%d\n", f.frame, p->a, p->b,
+          p->kind == detect::PairKind::crossing ? "crossing" : "touching", p->poly_a, p->poly_b);
       out.write(line, n);
     }
   }
@@ -64,11 +64,11 @@ void write_frames_csv(std::ostream& out, const Report& report) {
     const int64_t crossing = f.crossing_count();
     const int64_t pairs = static_cast<int64_t>(f.pairs.size());
     out << f.frame << ',' << csv_field(f.file) << ',';
-    const int n = std::snprintf(numbers, sizeof numbers,
-                                "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d\n",
-                                f.triangles, pairs, crossing, pairs - crossing, f.degenerate.size(),
-                                f.uncertain_tests, f.times.total(), f.rebuilt ? 1 : 0,
-                                f.topology_changed ? 1 : 0);
+    const int n = std::snprintf(
+        numbers, sizeof numbers,
+        "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d\n", f.triangles, pairs,
+        crossing, pairs - crossing, f.degenerate.size(), f.uncertain_tests, f.times.total(),
+        f.rebuilt ? 1 : 0, f.topology_changed ? 1 : 0);
     out.write(numbers, n);
   }
 }

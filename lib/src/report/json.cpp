@@ -9,9 +9,8 @@ namespace {
 using nlohmann::ordered_json;
 
 ordered_json seconds_json(const FrameRecord& f) {
-  return {{"read", f.read_seconds},       {"build", f.times.build},
-          {"refit", f.times.refit},       {"traverse", f.times.traverse},
-          {"exact", f.times.exact},       {"classify", f.times.classify},
+  return {{"read", f.read_seconds},       {"build", f.times.build}, {"refit", f.times.refit},
+          {"traverse", f.times.traverse}, {"exact", f.times.exact}, {"classify", f.times.classify},
           {"total", f.times.total()}};
 }
 
@@ -19,8 +18,11 @@ ordered_json frame_json(const FrameRecord& f) {
   const int64_t crossing = f.crossing_count();
   ordered_json pairs = ordered_json::array();
   for (const Pair& p : f.pairs)
-    pairs.push_back({{"a", p.a}, {"b", p.b}, {"kind", std::string(detect::to_string(p.kind))},
-                     {"poly_a", p.poly_a}, {"poly_b", p.poly_b}});
+    pairs.push_back({{"a", p.a},
+                     {"b", p.b},
+                     {"kind", std::string(detect::to_string(p.kind))},
+                     {"poly_a", p.poly_a},
+                     {"poly_b", p.poly_b}});
   ordered_json degenerate = ordered_json::array();
   for (const Face& d : f.degenerate) degenerate.push_back({{"face", d.face}, {"poly", d.poly}});
   ordered_json j;
@@ -79,24 +81,27 @@ std::string report_json(const Report& report) {
   ordered_json worst = nullptr;
   if (s.worst_frame) {
     const FrameRecord& w = report.frames[*s.worst_frame];
-    worst = {{"frame", w.frame}, {"file", w.file}, {"crossing", w.crossing_count()},
+    worst = {{"frame", w.frame},
+             {"file", w.file},
+             {"crossing", w.crossing_count()},
              {"pairs", w.pairs.size()}};
   }
-  j["summary"] = {{"frames_checked", s.frames_checked},
-                  {"frames_with_crossings", s.frames_with_crossings},
-                  {"frames_with_pairs", s.frames_with_pairs},
-                  {"worst_frame", std::move(worst)},
-                  {"pairs", s.pairs},
-                  {"crossing", s.crossing},
-                  {"touching", s.touching},
-                  {"degenerate", s.degenerate},
-                  {"uncertain_tests", s.uncertain_tests},
-                  {"topology_changes", s.topology_changes},
-                  {"builds", report.builds},
-                  {"rebuilds", report.rebuilds},
-                  {"seconds", {{"check", s.check_seconds}, {"read", s.read_seconds},
-                               {"wall", report.wall_seconds}}},
-                  {"failed", s.failed}};
+  j["summary"] = {
+      {"frames_checked", s.frames_checked},
+      {"frames_with_crossings", s.frames_with_crossings},
+      {"frames_with_pairs", s.frames_with_pairs},
+      {"worst_frame", std::move(worst)},
+      {"pairs", s.pairs},
+      {"crossing", s.crossing},
+      {"touching", s.touching},
+      {"degenerate", s.degenerate},
+      {"uncertain_tests", s.uncertain_tests},
+      {"topology_changes", s.topology_changes},
+      {"builds", report.builds},
+      {"rebuilds", report.rebuilds},
+      {"seconds",
+       {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", report.wall_seconds}}},
+      {"failed", s.failed}};
   // Invalid UTF-8 in a file name is replaced rather than thrown: the report must still be
   // written for a path the filesystem accepted.
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";

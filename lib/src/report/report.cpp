@@ -8,9 +8,12 @@ namespace snag::report {
 
 std::string_view to_string(FailOn fail_on) {
   switch (fail_on) {
-    case FailOn::crossing: return "crossing";
-    case FailOn::any: return "any";
-    case FailOn::none: return "none";
+    case FailOn::crossing:
+      return "crossing";
+    case FailOn::any:
+      return "any";
+    case FailOn::none:
+      return "none";
   }
   return "crossing";
 }
@@ -46,8 +49,9 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
   record.pairs.reserve(result.pairs.size());
   for (const auto& p : result.pairs) {
     // The checker's contract (a < b, sorted) is what makes the CSV bytes backend independent.
-    if (p.a >= p.b) throw InternalError("report: pair (" + std::to_string(p.a) + ", " +
-                                        std::to_string(p.b) + ") is not ordered a < b");
+    if (p.a >= p.b)
+      throw InternalError("report: pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+                          ") is not ordered a < b");
     record.pairs.push_back({p.a, p.b, p.kind, polygon_of(p.a), polygon_of(p.b)});
   }
   std::sort(record.pairs.begin(), record.pairs.end(),
@@ -84,16 +88,23 @@ Summary summarize(const Report& report) {
     s.topology_changes += f.topology_changed;
     s.check_seconds += f.times.total();
     s.read_seconds += f.read_seconds;
-    if (pairs > 0 && (crossing > worst_crossing || (crossing == worst_crossing && pairs > worst_pairs))) {
+    if (pairs > 0 &&
+        (crossing > worst_crossing || (crossing == worst_crossing && pairs > worst_pairs))) {
       s.worst_frame = i;
       worst_crossing = crossing;
       worst_pairs = pairs;
     }
   }
   switch (report.settings.fail_on) {
-    case FailOn::crossing: s.failed = s.crossing > 0; break;
-    case FailOn::any: s.failed = s.pairs > 0; break;
-    case FailOn::none: s.failed = false; break;
+    case FailOn::crossing:
+      s.failed = s.crossing > 0;
+      break;
+    case FailOn::any:
+      s.failed = s.pairs > 0;
+      break;
+    case FailOn::none:
+      s.failed = false;
+      break;
   }
   return s;
 }

@@ -45,7 +45,9 @@ void prepare_output_dir(const fs::path& dir) {
   const fs::path probe = temporary_name(dir, "probe");
   std::ofstream out(probe, std::ios::binary);
   const int err = errno;
-  if (!out) throw WriteError(dir, std::string("cannot write into the output directory: ") + std::strerror(err));
+  if (!out)
+    throw WriteError(dir,
+                     std::string("cannot write into the output directory: ") + std::strerror(err));
   out.close();
   remove_quietly(probe);
 }
@@ -58,7 +60,8 @@ void write_files_atomically(const fs::path& dir, const std::vector<OutputFile>& 
       const fs::path tmp = temporary_name(dir, file.name);
       temporaries.push_back(tmp);
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out) throw WriteError(dir / file.name, std::string("cannot create: ") + std::strerror(errno));
+      if (!out)
+        throw WriteError(dir / file.name, std::string("cannot create: ") + std::strerror(errno));
       file.write(out);
       out.close();
       // close() flushes; a full disk shows up here, not at the first write.
@@ -76,10 +79,10 @@ void write_files_atomically(const fs::path& dir, const std::vector<OutputFile>& 
 }
 
 void write_reports(const fs::path& dir, const Report& report) {
-  write_files_atomically(
-      dir, {{"pairs.csv", [&](std::ostream& out) { write_pairs_csv(out, report); }},
-            {"frames.csv", [&](std::ostream& out) { write_frames_csv(out, report); }},
-            {"report.json", [&](std::ostream& out) { out << report_json(report); }}});
+  write_files_atomically(dir,
+                         {{"pairs.csv", [&](std::ostream& out) { write_pairs_csv(out, report); }},
+                          {"frames.csv", [&](std::ostream& out) { write_frames_csv(out, report); }},
+                          {"report.json", [&](std::ostream& out) { out << report_json(report); }}});
 }
 
 }  // namespace snag::report

@@ -40,21 +40,21 @@ struct Face {
 };
 
 struct FrameRecord {
-  int64_t frame = 0;       ///< frame number, from the file name (0 for a single file without one)
-  std::string file;        ///< path as resolved from the sequence spec
+  int64_t frame = 0;  ///< frame number, from the file name (0 for a single file without one)
+  std::string file;   ///< path as resolved from the sequence spec
   int32_t vertices = 0;
   int32_t triangles = 0;
-  int64_t polygons = 0;    ///< faces as listed in the file
-  std::vector<Pair> pairs; ///< sorted by (a, b), unique
+  int64_t polygons = 0;          ///< faces as listed in the file
+  std::vector<Pair> pairs;       ///< sorted by (a, b), unique
   std::vector<Face> degenerate;  ///< sorted by face
   int64_t candidate_pairs = 0;
   int64_t filtered_tests = 0;
-  int64_t uncertain_tests = 0;   ///< tests the double filter left to exact arithmetic
-  bool topology_changed = false; ///< the face list differs from the previous checked frame's
-  bool rebuilt = false;          ///< the tree was built for this frame (always true for the first)
+  int64_t uncertain_tests = 0;    ///< tests the double filter left to exact arithmetic
+  bool topology_changed = false;  ///< the face list differs from the previous checked frame's
+  bool rebuilt = false;           ///< the tree was built for this frame (always true for the first)
   double tree_quality = 0;
-  detect::StageTimes times;      ///< checking only; times.total() is the frame's `seconds`
-  double read_seconds = 0;       ///< reading (and welding) the file
+  detect::StageTimes times;  ///< checking only; times.total() is the frame's `seconds`
+  double read_seconds = 0;   ///< reading (and welding) the file
 
   int64_t crossing_count() const;
   int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
@@ -79,10 +79,11 @@ struct Settings {
 };
 
 struct Inputs {
-  std::string sequence;         ///< the SEQUENCE argument as given
-  std::string ids = "file";     ///< "file" (snag's OBJ/PLY readers) or "assimp"
-  int64_t coincident_vertices = 0;  ///< exactly coincident vertices beyond the first of each spot, first frame
-  int64_t welded_vertices = 0;      ///< vertices merged into another by --weld, first frame
+  std::string sequence;      ///< the SEQUENCE argument as given
+  std::string ids = "file";  ///< "file" (snag's OBJ/PLY readers) or "assimp"
+  int64_t coincident_vertices =
+      0;  ///< exactly coincident vertices beyond the first of each spot, first frame
+  int64_t welded_vertices = 0;  ///< vertices merged into another by --weld, first frame
 };
 
 struct Report {
@@ -110,7 +111,7 @@ struct Summary {
   int64_t topology_changes = 0;
   double check_seconds = 0;  ///< sum of the frames' checking times
   double read_seconds = 0;
-  bool failed = false;       ///< the run fails under settings.fail_on
+  bool failed = false;  ///< the run fails under settings.fail_on
 };
 
 Summary summarize(const Report& report);
