@@ -29,6 +29,15 @@ SNAG_HD_INLINE int floor_log2(uint32_t x) {
 #endif
 }
 
+/// Number of trailing zero bits; x != 0.
+SNAG_HD_INLINE int count_trailing_zeros(uint32_t x) {
+#if defined(__CUDA_ARCH__)
+  return __ffs(static_cast<int>(x)) - 1;
+#else
+  return __builtin_ctz(x);
+#endif
+}
+
 struct CompleteTree {
   int32_t leaf_count = 0;    ///< n >= 1
   int32_t depth = 0;         ///< D, the deepest level

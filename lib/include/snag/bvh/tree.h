@@ -34,30 +34,35 @@ SNAG_HD_INLINE void refit_internal(int32_t node, TreeView tree) {
 /// Calls visit(triangle) for every leaf after `position` (in leaf order) whose box overlaps
 /// the leaf at `position`, so that each unordered pair of leaves is visited once, from the
 /// earlier one. For every ancestor reached from a left child, the right sibling's subtree holds
-/// exactly the later leaves under that ancestor; each is walked depth-first without a stack:
-/// the next node after i is i + 1 when i is a left child (odd), else the next after its parent,
-/// and the walk ends on climbing back to the subtree's root. Memory: a few registers.
+/// exactly the later leaves under that ancestor; each is walked depth-first without a stack.
+/// Memory: a few registers.
+///
+/// The walk's next node is chosen without a data-dependent branch: the left child when the
+/// box overlaps an internal node, else the next subtree in depth-first order. In 1-based
+/// numbering j = i + 1, left children are even and the parent of j is j >> 1, so climbing out
+/// of t right children and stepping to the sibling is (j >> t) + 1 in 1-based terms, (j >> t)
+/// in 0-based ones, with t the number of trailing ones of j. The walk ends when that climb
+/// would reach the subtree's root.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
   const CompleteTree shape = tree.shape;
+  const int32_t first_leaf = shape.leaf_count - 1;
   const int32_t leaf = shape.leaf_at(position);
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
     const int32_t root = node + 1;
+    const int root_level = CompleteTree::level_of(root);
     int32_t i = root;
     while (true) {
-      if (geom::overlap(box, tree.boxes[i])) {
-        if (!shape.is_leaf(i)) {
-          i = 2 * i + 1;
-          continue;
-        }
-        visit(tree.triangle_at[shape.position_of(i)]);
-      }
-      // Advance to the next subtree in depth-first order, or stop at the root.
-      while (i != root && !(i & 1)) i = (i - 1) >> 1;
-      if (i == root) break;
-      ++i;
+      const bool hit = geom::overlap(box, tree.boxes[i]);
+      const bool internal = i < first_leaf;
+      if (hit & !internal) visit(tree.triangle_at[shape.position_of(i)]);
+      const bool descend = hit & internal;
+      const uint32_t j = static_cast<uint32_t>(i) + 1;
+      const int climb = count_trailing_zeros(~j);
+      if (!descend & (climb >= floor_log2(j) - root_level)) break;
+      i = descend ? 2 * i + 1 : static_cast<int32_t>(j >> climb);
     }
   }
 }

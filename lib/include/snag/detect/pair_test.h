@@ -16,9 +16,22 @@ SNAG_HD_INLINE int shared_vertex_count(const geom::Tri& a, const geom::Tri& b) {
   return shared;
 }
 
-SNAG_HD_INLINE bool all_strictly_one_side(const geom::Sign s[3]) {
-  return (s[0] == geom::Sign::positive && s[1] == geom::Sign::positive && s[2] == geom::Sign::positive) ||
-         (s[0] == geom::Sign::negative && s[1] == geom::Sign::negative && s[2] == geom::Sign::negative);
+SNAG_HD_INLINE bool is_corner_of(int32_t v, const geom::Tri& x) { return v == x.v[0] || v == x.v[1] || v == x.v[2]; }
+
+/// Whether the corners of `t` that `x` does not share all lie strictly on one side of x's
+/// plane. Then t meets x's plane only in the shared corners, so the pair cannot intersect
+/// beyond them and no edge of either can hit the other: every test of the pair is ruled out.
+/// (Shared corners count as on the plane by topology; a corner on it by geometry does not.)
+/// This rejects most pairs of neighbouring triangles after one or two orientation tests.
+SNAG_HD_INLINE bool separated(const geom::Sign side[3], const geom::Tri& t, const geom::Tri& x) {
+  geom::Sign common = geom::Sign::zero;
+  for (int i = 0; i < 3; ++i) {
+    if (is_corner_of(t.v[i], x)) continue;
+    if (side[i] != geom::Sign::positive && side[i] != geom::Sign::negative) return false;
+    if (common == geom::Sign::zero) common = side[i];
+    else if (side[i] != common) return false;
+  }
+  return common != geom::Sign::zero;
 }
 
 /// Tests the edges triangle `t` represents against triangle `x`; `side` holds t's corners'
@@ -30,9 +43,7 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
   for (int k = 0; k < 3; ++k) {
     if (!(owned & (1u << k))) continue;
     const int32_t p = tt.v[k], q = tt.v[(k + 1) % 3];
-    const bool p_in_x = p == xt.v[0] || p == xt.v[1] || p == xt.v[2];
-    const bool q_in_x = q == xt.v[0] || q == xt.v[1] || q == xt.v[2];
-    if (p_in_x && q_in_x) continue;  // an edge of x itself
+    if (is_corner_of(p, xt) && is_corner_of(q, xt)) continue;  // an edge of x itself
     const int32_t edge = topo.triangle_edges[t][k];
     switch (geom::edge_hits_triangle(pred, p, q, xt, side[k], side[(k + 1) % 3])) {
       case geom::Answer::yes: sink.hit(edge, x); break;
@@ -57,12 +68,11 @@ SNAG_HD void test_candidate_pair(const P& pred, const TopologyView& topo, int32_
   }
   const uint8_t owned_t = topo.owned_edges[t], owned_x = topo.owned_edges[x];
   if (!owned_t && !owned_x) return;  // every edge of either is tested by its representative
-  // A triangle wholly on one side of the other's plane rules out every test of the pair.
   geom::Sign side_t[3], side_x[3];
   geom::corner_sides(pred, tt, xt, side_t);
-  if (all_strictly_one_side(side_t)) return;
+  if (separated(side_t, tt, xt)) return;
   geom::corner_sides(pred, xt, tt, side_x);
-  if (all_strictly_one_side(side_x)) return;
+  if (separated(side_x, xt, tt)) return;
   if (owned_t) test_owned_edges(pred, topo, t, tt, owned_t, x, xt, side_t, sink);
   if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, t, tt, side_x, sink);
 }

@@ -2,7 +2,8 @@
 // CGAL's exact predicates in validators/), run by both backends and by the exact resolver.
 //
 // P provides, on vertex ids:  Sign orient3d(a, b, c, d);  Sign orient2d(a, b, c, axis);
-//                             int dominant_axis(a, b, c).
+//                             int dominant_axis(a, b, c);
+//                             plane(a, b, c) with Sign side(d) == orient3d(a, b, c, d).
 //
 // What counts as an intersection (BRIEF.md): two triangles intersect when their closed sets
 // share a point that their shared vertices do not explain. For non-degenerate triangles F, X
@@ -172,10 +173,10 @@ SNAG_HD_INLINE Answer is_degenerate(const P& pred, int32_t a, int32_t b, int32_t
 /// The sides of triangle f's corners w.r.t. triangle x's plane; zero where a corner is a vertex of x.
 template <class P>
 SNAG_HD_INLINE void corner_sides(const P& pred, const Tri& f, const Tri& x, Sign side[3]) {
+  const auto plane = pred.plane(x.v[0], x.v[1], x.v[2]);
   for (int i = 0; i < 3; ++i) {
     const int32_t v = f.v[i];
-    side[i] = (v == x.v[0] || v == x.v[1] || v == x.v[2]) ? Sign::zero
-                                                          : pred.orient3d(x.v[0], x.v[1], x.v[2], v);
+    side[i] = (v == x.v[0] || v == x.v[1] || v == x.v[2]) ? Sign::zero : plane.side(v);
   }
 }
 

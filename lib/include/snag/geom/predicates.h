@@ -71,31 +71,58 @@ SNAG_HD_INLINE Sign orient2d(Vec3d a, Vec3d b, Vec3d c, int axis) {
   return orient2d(au, av, bu, bv, cu, cv);
 }
 
-/// Sign of det[b - a, c - a, d - a].
-SNAG_HD_INLINE Sign orient3d(Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
-  // Shewchuk's arrangement: differences to d, then 2x2 minors; his determinant is the
-  // negation of ours.
-  const double adx = a.x - d.x, bdx = b.x - d.x, cdx = c.x - d.x;
-  const double ady = a.y - d.y, bdy = b.y - d.y, cdy = c.y - d.y;
-  const double adz = a.z - d.z, bdz = b.z - d.z, cdz = c.z - d.z;
-  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
-  const double cdxady = cdx * ady, adxcdy = adx * cdy;
-  const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
-  const double permanent = (fabs(bdxcdy) + fabs(cdxbdy)) * fabs(adz) + (fabs(cdxady) + fabs(adxcdy)) * fabs(bdz) +
-                           (fabs(adxbdy) + fabs(bdxady)) * fabs(cdz);
-  if (permanent >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * permanent)
-    return negate(detail::sign_of(det));
-  if (permanent == 0.0) {
-    // Every term vanished; it is an exact zero unless a product underflowed to zero.
-    using detail::safe_difference;
-    if (safe_difference(adx) && safe_difference(bdx) && safe_difference(cdx) && safe_difference(ady) &&
-        safe_difference(bdy) && safe_difference(cdy) && safe_difference(adz) && safe_difference(bdz) &&
-        safe_difference(cdz))
-      return Sign::zero;
+/// orient3d(a, b, c, .) for a fixed plane through a, b, c: the plane's part of the determinant
+/// is computed once, each query point costs three differences, three products and a bound.
+///
+/// det[u, v, w] with u = b - a, v = c - a, w = d - a is w . (u x v): every entry of the 3x3
+/// matrix is a difference of two inputs, the 2x2 minors come from two rows and multiply the
+/// third, which is exactly the form of Shewchuk's orient3d (his rows are a - d, b - d, c - d),
+/// so his bound o3derrboundA times the permanent sum_k |w_k| (|u_i v_j| + |u_j v_i|) holds.
+struct PlaneFilter {
+  Vec3d origin, second, third;  ///< a, b, c
+  double minor[3];      ///< (u x v)_k, each rounded
+  double permanent[3];  ///< |u_i v_j| + |u_j v_i| for the same k
+
+  SNAG_HD_INLINE PlaneFilter(Vec3d a, Vec3d b, Vec3d c) : origin(a), second(b), third(c) {
+    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    const double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+    const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy, uyvx = uy * vx;
+    minor[0] = uyvz - uzvy;
+    minor[1] = uzvx - uxvz;
+    minor[2] = uxvy - uyvx;
+    permanent[0] = fabs(uyvz) + fabs(uzvy);
+    permanent[1] = fabs(uzvx) + fabs(uxvz);
+    permanent[2] = fabs(uxvy) + fabs(uyvx);
   }
-  return Sign::uncertain;
-}
+
+  /// Sign of det[b - a, c - a, d - a].
+  SNAG_HD_INLINE Sign side(Vec3d d) const {
+    const double wx = d.x - origin.x, wy = d.y - origin.y, wz = d.z - origin.z;
+    const double det = wx * minor[0] + wy * minor[1] + wz * minor[2];
+    const double perm = fabs(wx) * permanent[0] + fabs(wy) * permanent[1] + fabs(wz) * permanent[2];
+    if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm) return detail::sign_of(det);
+    return rare_zero(d, perm);
+  }
+
+ private:
+  /// The uncertain path: exact zeros the bound cannot show. A point equal to a corner repeats
+  /// a row of the matrix (unwelded seams do this often); a vanished permanent is an exact zero
+  /// unless a product underflowed to zero.
+  SNAG_HD Sign rare_zero(Vec3d d, double perm) const {
+    if (d == origin || d == second || d == third) return Sign::zero;
+    using detail::safe_difference;
+    if (perm == 0.0 && safe_difference(d.x - origin.x) && safe_difference(d.y - origin.y) &&
+        safe_difference(d.z - origin.z) && safe_difference(second.x - origin.x) &&
+        safe_difference(second.y - origin.y) && safe_difference(second.z - origin.z) &&
+        safe_difference(third.x - origin.x) && safe_difference(third.y - origin.y) &&
+        safe_difference(third.z - origin.z))
+      return Sign::zero;
+    return Sign::uncertain;
+  }
+};
+
+/// Sign of det[b - a, c - a, d - a]; bit for bit what PlaneFilter(a, b, c).side(d) answers.
+SNAG_HD_INLINE Sign orient3d(Vec3d a, Vec3d b, Vec3d c, Vec3d d) { return PlaneFilter(a, b, c).side(d); }
 
 /// The axis along which a triangle's normal has its largest component (as computed in
 /// doubles); projecting along it keeps the triangle as large as possible, which makes the
@@ -119,6 +146,16 @@ struct FilteredPredicates {
   }
   SNAG_HD_INLINE int dominant_axis(int32_t a, int32_t b, int32_t c) const {
     return geom::dominant_axis(positions[a], positions[b], positions[c]);
+  }
+  /// The plane through a, b, c, asked about many points: plane(a, b, c).side(d) ==
+  /// orient3d(a, b, c, d).
+  struct Plane {
+    PlaneFilter filter;
+    const Vec3d* positions;
+    SNAG_HD_INLINE Sign side(int32_t d) const { return filter.side(positions[d]); }
+  };
+  SNAG_HD_INLINE Plane plane(int32_t a, int32_t b, int32_t c) const {
+    return {PlaneFilter(positions[a], positions[b], positions[c]), positions};
   }
 };
 
