@@ -73,24 +73,39 @@ class CpuBackend final : public Backend {
     std::vector<uint8_t> degenerate_flags(static_cast<size_t>(n), 0);
     for (int32_t t : degenerate) degenerate_flags[t] = 1;
     const std::vector<uint8_t> owned = ownership_without(topo, degenerate);
-    const TopologyView view{topo.triangles.data(), topo.edges.data(), topo.triangle_edges.data(), owned.data(), n,
-                            static_cast<int32_t>(topo.edges.size())};
-    const geom::FilteredPredicates pred{positions_.data()};
+    const TopologyView view{topo.triangles.data(),   topo.edges.data(),         topo.triangle_edges.data(),
+                            owned.data(),            topo.listed_vertex.data(), topo.every_vertex_listed,
+                            n,                       static_cast<int32_t>(topo.edges.size())};
+    planes_.resize(static_cast<size_t>(n));
+#pragma omp parallel for num_threads(threads_) schedule(static)
+    for (int32_t t = 0; t < n; ++t) planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+    const FrameView frame_view{positions_.data(), planes_.data()};
     const bvh::TreeView tree = tree_.view();
 
     std::vector<ThreadSink> sinks(static_cast<size_t>(threads_));
 #pragma omp parallel num_threads(threads_)
     {
       ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
-      // Tasks in leaf order; dynamic chunks because leaves in dense regions cost more.
+      // Neighbour pairs from their list: their boxes always overlap.
+      const auto neighbor_count = static_cast<int64_t>(topo.neighbor_pairs.size());
+#pragma omp for schedule(static) nowait
+      for (int64_t i = 0; i < neighbor_count; ++i) {
+        const auto [t, x] = topo.neighbor_pairs[i];
+        if (degenerate_flags[t] || degenerate_flags[x]) continue;
+        ++sink.candidates;
+        test_candidate_pair(frame_view, view, t, x, sink);
+      }
+      // The other candidates from the traversal: tasks in leaf order; dynamic chunks because
+      // leaves in dense regions cost more.
 #pragma omp for schedule(dynamic, 256)
       for (int32_t position = 0; position < n; ++position) {
         const int32_t t = tree.triangle_at[position];
         if (degenerate_flags[t]) continue;
+        const geom::Tri tt = topo.triangles[t];
         bvh::for_each_later_overlap(tree, position, [&](int32_t x) {
-          if (degenerate_flags[x]) return;
+          if (degenerate_flags[x] || is_listed_neighbor(tt, topo.triangles[x], view.listed_vertex, view.every_vertex_listed)) return;
           ++sink.candidates;
-          test_candidate_pair(pred, view, t, x, sink);
+          test_candidate_pair(frame_view, view, t, x, sink);
         });
       }
     }
@@ -131,6 +146,7 @@ class CpuBackend final : public Backend {
   int threads_;
   const Topology* topology_ = nullptr;
   std::span<const geom::Vec3d> positions_;
+  std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
   bvh::Tree tree_;
 };
 

@@ -14,6 +14,40 @@ struct EdgeRecord {
   int32_t corner;    // the triangle's edge k joins corners k and k + 1
 };
 
+/// Lists the pairs of triangles around each vertex of valence at most kMaxListedValence.
+void make_neighbor_pairs(Topology& topo) {
+  const int32_t n = topo.triangle_count();
+  std::vector<uint8_t> usable(static_cast<size_t>(n), 1);
+  for (int32_t t : topo.index_degenerate) usable[t] = 0;
+  // Triangles around each vertex (CSR), in increasing id.
+  std::vector<int32_t> offsets(static_cast<size_t>(topo.vertex_count) + 1, 0);
+  for (int32_t t = 0; t < n; ++t)
+    if (usable[t])
+      for (int k = 0; k < 3; ++k) ++offsets[topo.triangles[t].v[k] + 1];
+  for (int32_t v = 0; v < topo.vertex_count; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int32_t> fan(static_cast<size_t>(offsets.back()));
+  std::vector<int32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (int32_t t = 0; t < n; ++t)
+    if (usable[t])
+      for (int k = 0; k < 3; ++k) fan[fill[topo.triangles[t].v[k]]++] = t;
+  topo.listed_vertex.assign(static_cast<size_t>(topo.vertex_count), 0);
+  topo.every_vertex_listed = true;
+  std::vector<std::array<int32_t, 2>>& pairs = topo.neighbor_pairs;
+  pairs.clear();
+  for (int32_t v = 0; v < topo.vertex_count; ++v) {
+    const int32_t begin = offsets[v], end = offsets[v + 1];
+    if (end - begin > Topology::kMaxListedValence) {
+      topo.every_vertex_listed = false;
+      continue;
+    }
+    topo.listed_vertex[v] = 1;
+    for (int32_t i = begin; i < end; ++i)
+      for (int32_t j = i + 1; j < end; ++j) pairs.push_back({fan[i], fan[j]});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
 }  // namespace
 
 Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_count) {
@@ -63,6 +97,7 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
     topo.edge_faces.push_back(rec.triangle);
   }
   if (!records.empty()) topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
+  make_neighbor_pairs(topo);
   return topo;
 }
 

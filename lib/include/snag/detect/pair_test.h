@@ -10,23 +10,46 @@
 
 namespace snag::detect {
 
-SNAG_HD_INLINE int shared_vertex_count(const geom::Tri& a, const geom::Tri& b) {
-  int shared = 0;
-  for (int i = 0; i < 3; ++i) shared += (a.v[i] == b.v[0]) + (a.v[i] == b.v[1]) + (a.v[i] == b.v[2]);
-  return shared;
-}
-
 SNAG_HD_INLINE bool is_corner_of(int32_t v, const geom::Tri& x) { return v == x.v[0] || v == x.v[1] || v == x.v[2]; }
 
-/// Whether the corners of `t` that `x` does not share all lie strictly on one side of x's
-/// plane. Then t meets x's plane only in the shared corners, so the pair cannot intersect
-/// beyond them and no edge of either can hit the other: every test of the pair is ruled out.
-/// (Shared corners count as on the plane by topology; a corner on it by geometry does not.)
-/// This rejects most pairs of neighbouring triangles after one or two orientation tests.
-SNAG_HD_INLINE bool separated(const geom::Sign side[3], const geom::Tri& t, const geom::Tri& x) {
+/// Whether the pair is tested by the neighbour pass (it shares a listed vertex, see
+/// Topology::neighbor_pairs) rather than from the traversal.
+SNAG_HD_INLINE bool is_listed_neighbor(const geom::Tri& t, const geom::Tri& x, const uint8_t* listed_vertex,
+                                       bool every_vertex_listed) {
+  if (every_vertex_listed) {  // the usual case: sharing any vertex is enough
+    bool shared = false;
+    for (int i = 0; i < 3; ++i) shared |= (t.v[i] == x.v[0]) | (t.v[i] == x.v[1]) | (t.v[i] == x.v[2]);
+    return shared;
+  }
+  bool listed = false;
+  for (int i = 0; i < 3; ++i) {
+    const bool shared = (t.v[i] == x.v[0]) | (t.v[i] == x.v[1]) | (t.v[i] == x.v[2]);
+    if (shared) listed |= listed_vertex[t.v[i]] != 0;
+  }
+  return listed;
+}
+
+/// Which corners of `t` are vertices of `x` (bit i for corner i of t) and which corners of `x`
+/// are vertices of `t`, from the nine id comparisons combined without branches.
+SNAG_HD_INLINE void shared_corners(const geom::Tri& t, const geom::Tri& x, uint32_t& t_shared, uint32_t& x_shared) {
+  uint32_t equal = 0;  // bit 3 i + j: t.v[i] == x.v[j]
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) equal |= static_cast<uint32_t>(t.v[i] == x.v[j]) << (3 * i + j);
+  t_shared = ((equal & 7u) != 0) | (((equal >> 3) & 7u) != 0) << 1 | (((equal >> 6) & 7u) != 0) << 2;
+  const uint32_t columns = equal | (equal >> 3) | (equal >> 6);
+  x_shared = columns & 7u;
+}
+
+/// Whether the corners of `t` that `x` does not share (`shared`: shared_corners(t, x)) all lie
+/// strictly on one side of x's plane. Then t meets x's plane only in the shared corners, so
+/// the pair cannot intersect beyond them and no edge of either can hit the other: every test
+/// of the pair is ruled out. (Shared corners count as on the plane by topology; a corner on it
+/// by geometry does not.) This rejects most pairs of neighbouring triangles after one or two
+/// orientation tests.
+SNAG_HD_INLINE bool separated(const geom::Sign side[3], uint32_t shared) {
   geom::Sign common = geom::Sign::zero;
   for (int i = 0; i < 3; ++i) {
-    if (is_corner_of(t.v[i], x)) continue;
+    if (shared & (1u << i)) continue;
     if (side[i] != geom::Sign::positive && side[i] != geom::Sign::negative) return false;
     if (common == geom::Sign::zero) common = side[i];
     else if (side[i] != common) return false;
@@ -38,12 +61,13 @@ SNAG_HD_INLINE bool separated(const geom::Sign side[3], const geom::Tri& t, cons
 /// sides w.r.t. x's plane.
 template <class P, class Sink>
 SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, int32_t t, const geom::Tri& tt,
-                                     uint8_t owned, int32_t x, const geom::Tri& xt, const geom::Sign side[3],
-                                     Sink& sink) {
+                                     uint8_t owned, uint32_t shared, int32_t x, const geom::Tri& xt,
+                                     const geom::Sign side[3], Sink& sink) {
   for (int k = 0; k < 3; ++k) {
     if (!(owned & (1u << k))) continue;
     const int32_t p = tt.v[k], q = tt.v[(k + 1) % 3];
-    if (is_corner_of(p, xt) && is_corner_of(q, xt)) continue;  // an edge of x itself
+    const uint32_t edge_corners = (1u << k) | (1u << ((k + 1) % 3));
+    if ((shared & edge_corners) == edge_corners) continue;  // an edge of x itself
     const int32_t edge = topo.triangle_edges[t][k];
     switch (geom::edge_hits_triangle(pred, p, q, xt, side[k], side[(k + 1) % 3])) {
       case geom::Answer::yes: sink.hit(edge, x); break;
@@ -53,28 +77,63 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
   }
 }
 
+/// What the pair tests read of one frame: the positions and every triangle's plane
+/// (PlaneCoefficients::of its corners), computed once per frame.
+struct FrameView {
+  const geom::Vec3d* positions = nullptr;
+  const geom::PlaneCoefficients* planes = nullptr;
+};
+
+SNAG_HD_INLINE geom::PlaneCoefficients triangle_plane(const geom::Vec3d* positions, const geom::Tri& t) {
+  return geom::PlaneCoefficients::of(positions[t.v[0]], positions[t.v[1]], positions[t.v[2]]);
+}
+
+/// The sides of t's corners w.r.t. the plane of triangle x (`plane`): zero for the corners
+/// in `shared` (vertices of x); orient3d(x0, x1, x2, corner) otherwise, bit for bit.
+SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions, const geom::PlaneCoefficients& plane,
+                                  const geom::Tri& t, uint32_t shared, const geom::Tri& x, geom::Sign side[3]) {
+  const geom::Vec3d origin = positions[x.v[0]];
+  for (int i = 0; i < 3; ++i) {
+    if (shared & (1u << i)) {
+      side[i] = geom::Sign::zero;
+      continue;
+    }
+    const geom::Vec3d d = positions[t.v[i]];
+    const double wx = d.x - origin.x, wy = d.y - origin.y, wz = d.z - origin.z;
+    const double det = wx * plane.minor[0] + wy * plane.minor[1] + wz * plane.minor[2];
+    const double perm = fabs(wx) * plane.permanent[0] + fabs(wy) * plane.permanent[1] + fabs(wz) * plane.permanent[2];
+    if (perm >= geom::detail::kMinPermanent && fabs(det) > geom::detail::kOrient3dBound * perm)
+      side[i] = det > 0 ? geom::Sign::positive : geom::Sign::negative;
+    else
+      side[i] = geom::detail::plane_side_rare(origin, positions[x.v[1]], positions[x.v[2]], d, perm);
+  }
+}
+
 /// The narrow phase of the candidate pair (t, x), neither degenerate. Reports to `sink`:
 ///   hit(edge, triangle)       an edge meets a triangle beyond their shared endpoints: every
 ///                             face of the edge intersects the triangle;
 ///   uncertain(edge, triangle) the filter could not decide that test;
 ///   miss()                    a test decided `no` (counted);
 ///   duplicate(t, x)           the two share all three vertices (a duplicated face).
-template <class P, class Sink>
-SNAG_HD void test_candidate_pair(const P& pred, const TopologyView& topo, int32_t t, int32_t x, Sink& sink) {
+template <class Sink>
+SNAG_HD void test_candidate_pair(const FrameView& frame, const TopologyView& topo, int32_t t, int32_t x, Sink& sink) {
   const geom::Tri tt = topo.triangles[t], xt = topo.triangles[x];
-  if (shared_vertex_count(tt, xt) == 3) {
+  uint32_t t_shared, x_shared;
+  shared_corners(tt, xt, t_shared, x_shared);
+  if (t_shared == 7u) {
     sink.duplicate(t, x);
     return;
   }
   const uint8_t owned_t = topo.owned_edges[t], owned_x = topo.owned_edges[x];
   if (!owned_t && !owned_x) return;  // every edge of either is tested by its representative
   geom::Sign side_t[3], side_x[3];
-  geom::corner_sides(pred, tt, xt, side_t);
-  if (separated(side_t, tt, xt)) return;
-  geom::corner_sides(pred, xt, tt, side_x);
-  if (separated(side_x, xt, tt)) return;
-  if (owned_t) test_owned_edges(pred, topo, t, tt, owned_t, x, xt, side_t, sink);
-  if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, t, tt, side_x, sink);
+  sides_against(frame.positions, frame.planes[x], tt, t_shared, xt, side_t);
+  if (separated(side_t, t_shared)) return;
+  sides_against(frame.positions, frame.planes[t], xt, x_shared, tt, side_x);
+  if (separated(side_x, x_shared)) return;
+  const geom::FilteredPredicates pred{frame.positions};
+  if (owned_t) test_owned_edges(pred, topo, t, tt, owned_t, t_shared, x, xt, side_t, sink);
+  if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, x_shared, t, tt, side_x, sink);
 }
 
 }  // namespace snag::detect

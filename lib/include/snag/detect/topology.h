@@ -2,6 +2,7 @@
 // representative-triangle ownership of edges (Curtis, Tamstorf and Manocha 2008).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -28,6 +29,15 @@ struct Topology {
   std::vector<uint8_t> owned_edges;
   /// Triangles whose corners repeat a vertex id: degenerate in every frame.
   std::vector<int32_t> index_degenerate;
+  /// Neighbour pairs (a < b, sorted): triangles sharing a listed vertex. They make most of the
+  /// candidates in a mesh (about 7 per triangle in a cloth) and never change with the frame,
+  /// so they are tested in a pass over this list and skipped by the traversal. A vertex is
+  /// listed when at most kMaxListedValence triangles use it, which bounds the list by
+  /// kMaxListedValence^2 / 2 pairs per vertex; pairs around larger fans stay with the traversal.
+  std::vector<std::array<int32_t, 2>> neighbor_pairs;
+  std::vector<uint8_t> listed_vertex;  ///< per vertex: 1 when its fan's pairs are listed
+  bool every_vertex_listed = true;
+  static constexpr int32_t kMaxListedValence = 32;
 
   int32_t triangle_count() const { return static_cast<int32_t>(triangles.size()); }
 };
@@ -44,6 +54,8 @@ struct TopologyView {
   const std::array<int32_t, 2>* edges = nullptr;
   const std::array<int32_t, 3>* triangle_edges = nullptr;
   const uint8_t* owned_edges = nullptr;
+  const uint8_t* listed_vertex = nullptr;
+  bool every_vertex_listed = true;
   int32_t triangle_count = 0;
   int32_t edge_count = 0;
 };

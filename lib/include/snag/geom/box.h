@@ -4,6 +4,8 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "snag/geom/hd.h"
 #include "snag/geom/vec3.h"
@@ -15,26 +17,44 @@ struct Box3f {
   float hi[3];
 };
 
-/// The largest float not above x (x finite).
-SNAG_HD_INLINE float float_down(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = nextafterf(f, -FLT_MAX);
+#if defined(__CUDA_ARCH__)
+/// The largest float not above x (x finite): the conversion rounds down.
+SNAG_HD_INLINE float float_down(double x) { return __double2float_rd(x); }
+/// The smallest float not below x (x finite): the conversion rounds up.
+SNAG_HD_INLINE float float_up(double x) { return __double2float_ru(x); }
+#else
+/// The float one unit in the last place below / above finite f, by its bit pattern (the
+/// library's nextafterf is an out-of-line call in the refit's innermost loop).
+inline float float_step(float f, bool up) {
+  if (f == 0.0f) return up ? FLT_TRUE_MIN : -FLT_TRUE_MIN;
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  bits += ((f > 0.0f) == up) ? 1u : static_cast<uint32_t>(-1);
+  std::memcpy(&f, &bits, sizeof bits);
   return f;
+}
+/// The largest float not above x (x finite).
+inline float float_down(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? float_step(f, false) : f;
 }
 /// The smallest float not below x (x finite).
-SNAG_HD_INLINE float float_up(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = nextafterf(f, FLT_MAX);
-  return f;
+inline float float_up(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? float_step(f, true) : f;
 }
+#endif
 
 SNAG_HD_INLINE Box3f empty_box() { return {{FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}}; }
 
 SNAG_HD_INLINE Box3f triangle_box(Vec3d a, Vec3d b, Vec3d c) {
   Box3f box;
+  // Plain comparisons rather than fmin/fmax: coordinates are never NaN (readers reject them),
+  // and the library calls would not be inlined.
   for (int k = 0; k < 3; ++k) {
-    double lo = fmin(fmin(coord(a, k), coord(b, k)), coord(c, k));
-    double hi = fmax(fmax(coord(a, k), coord(b, k)), coord(c, k));
+    const double ak = coord(a, k), bk = coord(b, k), ck = coord(c, k);
+    const double lo = ak < bk ? (ak < ck ? ak : ck) : (bk < ck ? bk : ck);
+    const double hi = ak > bk ? (ak > ck ? ak : ck) : (bk > ck ? bk : ck);
     box.lo[k] = float_down(lo);
     box.hi[k] = float_up(hi);
   }
@@ -44,8 +64,8 @@ SNAG_HD_INLINE Box3f triangle_box(Vec3d a, Vec3d b, Vec3d c) {
 SNAG_HD_INLINE Box3f merge(const Box3f& a, const Box3f& b) {
   Box3f m;
   for (int k = 0; k < 3; ++k) {
-    m.lo[k] = fminf(a.lo[k], b.lo[k]);
-    m.hi[k] = fmaxf(a.hi[k], b.hi[k]);
+    m.lo[k] = a.lo[k] < b.lo[k] ? a.lo[k] : b.lo[k];
+    m.hi[k] = a.hi[k] > b.hi[k] ? a.hi[k] : b.hi[k];
   }
   return m;
 }

@@ -72,57 +72,53 @@ SNAG_HD_INLINE Sign orient2d(Vec3d a, Vec3d b, Vec3d c, int axis) {
 }
 
 /// orient3d(a, b, c, .) for a fixed plane through a, b, c: the plane's part of the determinant
-/// is computed once, each query point costs three differences, three products and a bound.
+/// is computed once (per frame, for every triangle), each query point then costs three
+/// differences, six products and a bound (48 bytes per plane).
 ///
 /// det[u, v, w] with u = b - a, v = c - a, w = d - a is w . (u x v): every entry of the 3x3
 /// matrix is a difference of two inputs, the 2x2 minors come from two rows and multiply the
 /// third, which is exactly the form of Shewchuk's orient3d (his rows are a - d, b - d, c - d),
 /// so his bound o3derrboundA times the permanent sum_k |w_k| (|u_i v_j| + |u_j v_i|) holds.
-struct PlaneFilter {
-  Vec3d origin, second, third;  ///< a, b, c
+struct PlaneCoefficients {
   double minor[3];      ///< (u x v)_k, each rounded
   double permanent[3];  ///< |u_i v_j| + |u_j v_i| for the same k
 
-  SNAG_HD_INLINE PlaneFilter(Vec3d a, Vec3d b, Vec3d c) : origin(a), second(b), third(c) {
+  SNAG_HD_INLINE static PlaneCoefficients of(Vec3d a, Vec3d b, Vec3d c) {
     const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
     const double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
     const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy, uyvx = uy * vx;
-    minor[0] = uyvz - uzvy;
-    minor[1] = uzvx - uxvz;
-    minor[2] = uxvy - uyvx;
-    permanent[0] = fabs(uyvz) + fabs(uzvy);
-    permanent[1] = fabs(uzvx) + fabs(uxvz);
-    permanent[2] = fabs(uxvy) + fabs(uyvx);
-  }
-
-  /// Sign of det[b - a, c - a, d - a].
-  SNAG_HD_INLINE Sign side(Vec3d d) const {
-    const double wx = d.x - origin.x, wy = d.y - origin.y, wz = d.z - origin.z;
-    const double det = wx * minor[0] + wy * minor[1] + wz * minor[2];
-    const double perm = fabs(wx) * permanent[0] + fabs(wy) * permanent[1] + fabs(wz) * permanent[2];
-    if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm) return detail::sign_of(det);
-    return rare_zero(d, perm);
-  }
-
- private:
-  /// The uncertain path: exact zeros the bound cannot show. A point equal to a corner repeats
-  /// a row of the matrix (unwelded seams do this often); a vanished permanent is an exact zero
-  /// unless a product underflowed to zero.
-  SNAG_HD Sign rare_zero(Vec3d d, double perm) const {
-    if (d == origin || d == second || d == third) return Sign::zero;
-    using detail::safe_difference;
-    if (perm == 0.0 && safe_difference(d.x - origin.x) && safe_difference(d.y - origin.y) &&
-        safe_difference(d.z - origin.z) && safe_difference(second.x - origin.x) &&
-        safe_difference(second.y - origin.y) && safe_difference(second.z - origin.z) &&
-        safe_difference(third.x - origin.x) && safe_difference(third.y - origin.y) &&
-        safe_difference(third.z - origin.z))
-      return Sign::zero;
-    return Sign::uncertain;
+    return {{uyvz - uzvy, uzvx - uxvz, uxvy - uyvx},
+            {fabs(uyvz) + fabs(uzvy), fabs(uzvx) + fabs(uxvz), fabs(uxvy) + fabs(uyvx)}};
   }
 };
 
-/// Sign of det[b - a, c - a, d - a]; bit for bit what PlaneFilter(a, b, c).side(d) answers.
-SNAG_HD_INLINE Sign orient3d(Vec3d a, Vec3d b, Vec3d c, Vec3d d) { return PlaneFilter(a, b, c).side(d); }
+namespace detail {
+/// The uncertain path: exact zeros the bound cannot show. A point equal to a corner repeats a
+/// row of the matrix (unwelded seams do this often); a vanished permanent is an exact zero
+/// unless a product underflowed to zero.
+SNAG_HD inline Sign plane_side_rare(Vec3d a, Vec3d b, Vec3d c, Vec3d d, double perm) {
+  if (d == a || d == b || d == c) return Sign::zero;
+  if (perm == 0.0 && safe_difference(d.x - a.x) && safe_difference(d.y - a.y) && safe_difference(d.z - a.z) &&
+      safe_difference(b.x - a.x) && safe_difference(b.y - a.y) && safe_difference(b.z - a.z) &&
+      safe_difference(c.x - a.x) && safe_difference(c.y - a.y) && safe_difference(c.z - a.z))
+    return Sign::zero;
+  return Sign::uncertain;
+}
+}  // namespace detail
+
+/// Sign of det[b - a, c - a, d - a] from the plane's coefficients (k = PlaneCoefficients::of(a, b, c)).
+SNAG_HD_INLINE Sign plane_side(const PlaneCoefficients& k, Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
+  const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
+  const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
+  const double perm = fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
+  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm) return detail::sign_of(det);
+  return detail::plane_side_rare(a, b, c, d, perm);
+}
+
+/// Sign of det[b - a, c - a, d - a]; bit for bit what plane_side answers.
+SNAG_HD_INLINE Sign orient3d(Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
+  return plane_side(PlaneCoefficients::of(a, b, c), a, b, c, d);
+}
 
 /// The axis along which a triangle's normal has its largest component (as computed in
 /// doubles); projecting along it keeps the triangle as large as possible, which makes the
@@ -150,12 +146,14 @@ struct FilteredPredicates {
   /// The plane through a, b, c, asked about many points: plane(a, b, c).side(d) ==
   /// orient3d(a, b, c, d).
   struct Plane {
-    PlaneFilter filter;
+    PlaneCoefficients k;
+    Vec3d a, b, c;
     const Vec3d* positions;
-    SNAG_HD_INLINE Sign side(int32_t d) const { return filter.side(positions[d]); }
+    SNAG_HD_INLINE Sign side(int32_t d) const { return plane_side(k, a, b, c, positions[d]); }
   };
   SNAG_HD_INLINE Plane plane(int32_t a, int32_t b, int32_t c) const {
-    return {PlaneFilter(positions[a], positions[b], positions[c]), positions};
+    const Vec3d pa = positions[a], pb = positions[b], pc = positions[c];
+    return {PlaneCoefficients::of(pa, pb, pc), pa, pb, pc, positions};
   }
 };
 
