@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <array>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -245,20 +244,14 @@ TEST(ObjReader, ReadsAGridWithTheFilesIds) {
   EXPECT_EQ(m.source_polygon.back(), 2 * n * n - 1);
 }
 
-// Not a benchmark: a generous bound that only a badly slow reader (iostreams, per-line
-// allocation) would miss, on the 36K-triangle frame size.
-TEST(ObjReader, ThirtySixThousandTrianglesReadQuickly) {
+// The 36K-triangle frame size, read whole (its speed is measured by `snag bench cpu`,
+// not here: timings do not belong in unit tests).
+TEST(ObjReader, ThirtySixThousandTriangleGrid) {
   const std::string text = make_grid_obj(134);  // 35,912 triangles, 18,225 vertices
-  double best = 1e9;
-  for (int rep = 0; rep < 5; ++rep) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const mesh::Mesh m = read_obj(text, "grid.obj");
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    best = std::min(best, s);
-    ASSERT_EQ(m.triangles.size(), 35912u);
-  }
-  RecordProperty("megabytes_per_second", static_cast<int>(text.size() / best / 1e6));
-  EXPECT_LT(best, 0.050) << text.size() / best / 1e6 << " MB/s";
+  const mesh::Mesh m = read_obj(text, "grid.obj");
+  ASSERT_EQ(m.triangles.size(), 35912u);
+  ASSERT_EQ(m.positions.size(), 18225u);
+  EXPECT_EQ(m.source_polygon.back(), 35911);
 }
 
 TEST(ReadMesh, DispatchesByExtensionCaseInsensitively) {

@@ -20,11 +20,13 @@ class InputError : public std::runtime_error {
   int64_t byte_offset() const { return byte_offset_; }  ///< -1 when not a byte offset
 
  private:
+  // Appends rather than chaining operator+: GCC 12 warns falsely (-Wrestrict) on the chain.
   static std::string format(const std::string& path, int64_t line, int64_t offset, const std::string& what) {
-    std::string where = path;
-    if (line > 0) where += ":" + std::to_string(line);
-    if (offset >= 0) where += " (byte " + std::to_string(offset) + ")";
-    return where + ": " + what;
+    std::string message = path;
+    if (line > 0) message.append(":").append(std::to_string(line));
+    if (offset >= 0) message.append(" (byte ").append(std::to_string(offset)).append(")");
+    message.append(": ").append(what);
+    return message;
   }
   std::string path_;
   int64_t line_;
