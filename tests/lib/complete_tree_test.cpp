@@ -162,5 +162,31 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   }
 }
 
+TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
+  for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 100, 513, 2000}) {
+    for (double size : {0.2, 1.0, 4.0}) {
+      const uint32_t seed = static_cast<uint32_t>(n * 17 + size * 3);
+      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) + " seed=" + std::to_string(seed));
+      Soup soup = random_soup(n, seed, size);
+      Tree tree;
+      tree.build(soup.view(), 2);
+      const TreeView view = tree.view();
+      std::multiset<std::pair<int32_t, int32_t>> per_leaf, grouped;
+      for (int32_t p = 0; p < n; ++p) {
+        const int32_t t = view.triangle_at[p];
+        for_each_later_overlap(view, p, [&](int32_t x) { per_leaf.insert({std::min(t, x), std::max(t, x)}); });
+      }
+      const int32_t level = group_level(view.shape);
+      const int32_t first = CompleteTree::level_begin(level);
+      const int32_t last = std::min(CompleteTree::level_begin(level + 1), view.shape.node_count());
+      for (int32_t group = first; group < last; ++group)
+        for_each_later_overlap_grouped(view, group, [&](int32_t t, int32_t x) {
+          grouped.insert({std::min(t, x), std::max(t, x)});
+        });
+      ASSERT_EQ(grouped, per_leaf);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace snag::bvh

@@ -95,15 +95,18 @@ class CpuBackend final : public Backend {
         ++sink.candidates;
         test_candidate_pair(frame_view, view, t, x, sink);
       }
-      // The other candidates from the traversal: tasks in leaf order; dynamic chunks because
-      // leaves in dense regions cost more.
-#pragma omp for schedule(dynamic, 256)
-      for (int32_t position = 0; position < n; ++position) {
-        const int32_t t = tree.triangle_at[position];
-        if (degenerate_flags[t]) continue;
-        const geom::Tri tt = topo.triangles[t];
-        bvh::for_each_later_overlap(tree, position, [&](int32_t x) {
-          if (degenerate_flags[x] || is_listed_neighbor(tt, topo.triangles[x], view.listed_vertex, view.every_vertex_listed)) return;
+      // The other candidates from the traversal: the leaves of each group of up to four
+      // consecutive positions walk the tree together (for_each_later_overlap_grouped), groups
+      // in leaf order; dynamic chunks because groups in dense regions cost more.
+      const int32_t level = bvh::group_level(tree.shape);
+      const int32_t first_group = bvh::CompleteTree::level_begin(level);
+      const int32_t last_group = std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+#pragma omp for schedule(dynamic, 64)
+      for (int32_t group = first_group; group < last_group; ++group) {
+        bvh::for_each_later_overlap_grouped(tree, group, [&](int32_t t, int32_t x) {
+          if (degenerate_flags[t] || degenerate_flags[x] ||
+              is_listed_neighbor(topo.triangles[t], topo.triangles[x], view.listed_vertex, view.every_vertex_listed))
+            return;
           ++sink.candidates;
           test_candidate_pair(frame_view, view, t, x, sink);
         });
