@@ -134,7 +134,7 @@ class CpuBackend final : public Backend {
               [](const FacePair& x, const FacePair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
     std::vector<uint8_t> pair_flags(frame.pairs.size(), 1), duplicate_flags(duplicates.size(), 1);
     merge_pairs(frame.pairs, pair_flags, duplicates, duplicate_flags);
-    const int64_t uncertain_kinds = classify_pairs(positions_, topo, frame.pairs, frame.kind_certain, threads_);
+    const int64_t uncertain_kinds = classify_pairs(positions_, topo, frame.pairs, frame.kind_certain, threads_, planes_.data());
     frame.filtered_tests += static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
     frame.classify_seconds = seconds_since(classify_start);
     return frame;

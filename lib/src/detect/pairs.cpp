@@ -2,26 +2,58 @@
 
 #include <algorithm>
 
+#include "snag/detect/pair_test.h"
 #include "snag/geom/narrow_phase.h"
 
 namespace snag::detect {
 
+namespace {
+
+/// Sorts and deduplicates keys below 2^bits with a least-significant-digit radix sort (11-bit
+/// digits): linear in the count, where a comparison sort of a frame's hundreds of thousands of
+/// hit pairs was a third of the frame.
+void sort_unique(std::vector<uint64_t>& keys, int bits) {
+  constexpr int kDigit = 11;
+  constexpr size_t kBuckets = size_t{1} << kDigit;
+  std::vector<uint64_t> scratch(keys.size());
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::vector<size_t> start(kBuckets + 1, 0);
+    for (uint64_t k : keys) ++start[((k >> shift) & (kBuckets - 1)) + 1];
+    for (size_t b = 0; b < kBuckets; ++b) start[b + 1] += start[b];
+    for (uint64_t k : keys) scratch[start[(k >> shift) & (kBuckets - 1)]++] = k;
+    keys.swap(scratch);
+  }
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+int bits_for(int64_t count) {
+  int bits = 1;
+  while ((int64_t{1} << bits) < count) ++bits;
+  return bits;
+}
+
+}  // namespace
+
 std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTriangleTask> hits,
                                   std::span<const uint8_t> degenerate_flags) {
-  std::vector<FacePair> pairs;
-  pairs.reserve(hits.size() * 2);
+  // Pairs packed as a << id_bits | b, so that sorting the keys sorts by (a, b).
+  const int id_bits = bits_for(topo.triangle_count());
+  std::vector<uint64_t> keys;
+  keys.reserve(hits.size() * 2);
   for (const EdgeTriangleTask& hit : hits) {
     for (int32_t i = topo.edge_face_offsets[hit.edge]; i < topo.edge_face_offsets[hit.edge + 1]; ++i) {
       const int32_t face = topo.edge_faces[i];
       if (face == hit.triangle || degenerate_flags[face]) continue;
-      pairs.push_back({std::min(face, hit.triangle), std::max(face, hit.triangle), PairKind::touching});
+      const auto a = static_cast<uint64_t>(std::min(face, hit.triangle));
+      const auto b = static_cast<uint64_t>(std::max(face, hit.triangle));
+      keys.push_back(a << id_bits | b);
     }
   }
-  auto by_ids = [](const FacePair& x, const FacePair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; };
-  std::sort(pairs.begin(), pairs.end(), by_ids);
-  pairs.erase(std::unique(pairs.begin(), pairs.end(),
-                          [](const FacePair& x, const FacePair& y) { return x.a == y.a && x.b == y.b; }),
-              pairs.end());
+  sort_unique(keys, 2 * id_bits);
+  std::vector<FacePair> pairs(keys.size());
+  const uint64_t low = (uint64_t{1} << id_bits) - 1;
+  for (size_t i = 0; i < keys.size(); ++i)
+    pairs[i] = {static_cast<int32_t>(keys[i] >> id_bits), static_cast<int32_t>(keys[i] & low), PairKind::touching};
   return pairs;
 }
 
@@ -51,7 +83,7 @@ void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags, 
 }
 
 int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topo, std::span<FacePair> pairs,
-                       std::vector<uint8_t>& certain, int threads) {
+                       std::vector<uint8_t>& certain, int threads, const geom::PlaneCoefficients* planes) {
   certain.assign(pairs.size(), 1);
   const geom::FilteredPredicates pred{positions.data()};
   int64_t uncertain = 0;
@@ -59,7 +91,19 @@ int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& t
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : uncertain) if (count > 4096)
   for (int64_t i = 0; i < count; ++i) {
     FacePair& pair = pairs[i];
-    const geom::Answer crossing = geom::is_crossing(pred, topo.triangles[pair.a], topo.triangles[pair.b]);
+    const geom::Tri& f = topo.triangles[pair.a];
+    const geom::Tri& x = topo.triangles[pair.b];
+    geom::Answer crossing;
+    if (planes) {
+      uint32_t f_shared, x_shared;
+      shared_corners(f, x, f_shared, x_shared);
+      geom::Sign sf[3], sx[3];
+      sides_against(positions.data(), planes[pair.b], f, f_shared, x, sf);
+      sides_against(positions.data(), planes[pair.a], x, x_shared, f, sx);
+      crossing = geom::is_crossing_given_sides(pred, f, x, sf, sx);
+    } else {
+      crossing = geom::is_crossing(pred, f, x);
+    }
     if (crossing == geom::Answer::uncertain) {
       certain[i] = 0;
       ++uncertain;

@@ -9,6 +9,7 @@
 #include "snag/detect/exact.h"
 #include "snag/detect/result.h"
 #include "snag/detect/topology.h"
+#include "snag/geom/predicates.h"
 
 namespace snag::detect {
 
@@ -23,8 +24,9 @@ void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags, 
                  std::span<const uint8_t> more_flags);
 
 /// Sets each pair's kind with the double filter; certain[i] = 0 where the filter could not
-/// tell (the caller decides those exactly). Returns how many were uncertain.
+/// tell (the caller decides those exactly). `planes`, when given, are the frame's triangle
+/// planes (pair_test.h), saving their recomputation. Returns how many were uncertain.
 int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topology, std::span<FacePair> pairs,
-                       std::vector<uint8_t>& certain, int threads);
+                       std::vector<uint8_t>& certain, int threads, const geom::PlaneCoefficients* planes = nullptr);
 
 }  // namespace snag::detect

@@ -204,11 +204,9 @@ SNAG_HD_INLINE int lone_corner(const Sign side[3]) {
 /// x0 - f0 along (fi - f0), L and (xj - x0) and use that (fi - f0).n_x < 0 and
 /// (xj - x0).n_f < 0. So the segments overlap in positive length iff some Ii < some Jj and
 /// some Jj < some Ii: among the four signs there is a positive and a negative one.
+/// sf: the sides of f's corners w.r.t. x's plane; sx: of x's w.r.t. f's (zero where shared).
 template <class P>
-SNAG_HD Answer is_crossing(const P& pred, const Tri& f, const Tri& x) {
-  Sign sf[3], sx[3];
-  corner_sides(pred, f, x, sf);
-  corner_sides(pred, x, f, sx);
+SNAG_HD Answer is_crossing_given_sides(const P& pred, const Tri& f, const Tri& x, const Sign sf[3], const Sign sx[3]) {
   for (int i = 0; i < 3; ++i)
     if (sf[i] == Sign::uncertain || sx[i] == Sign::uncertain) return Answer::uncertain;
   const int fi = lone_corner(sf), xi = lone_corner(sx);
@@ -225,6 +223,16 @@ SNAG_HD Answer is_crossing(const P& pred, const Tri& f, const Tri& x) {
   }
   if (positive && negative) return Answer::yes;
   return uncertain ? Answer::uncertain : Answer::no;
+}
+
+/// is_crossing with the sides of f's corners w.r.t. x's plane (sf) and of x's w.r.t. f's (sx)
+/// computed here (see is_crossing_given_sides for callers that have them already).
+template <class P>
+SNAG_HD Answer is_crossing(const P& pred, const Tri& f, const Tri& x) {
+  Sign sf[3], sx[3];
+  corner_sides(pred, f, x, sf);
+  corner_sides(pred, x, f, sx);
+  return is_crossing_given_sides(pred, f, x, sf, sx);
 }
 
 }  // namespace snag::geom
