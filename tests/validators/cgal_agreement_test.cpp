@@ -144,6 +144,27 @@ TEST(CgalAgreement, SampleSequenceMatchesSelfIntersections) {
   EXPECT_GE(with_pairs, 5);
 }
 
+TEST(CgalReference, SequenceReusingTheMeshMatchesFreshMeshes) {
+  const auto dir = test::source_dir() / "samples" / "drape";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no samples/drape under " << test::source_dir();
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (entry.path().extension() == ".obj") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 2u);
+  const mesh::Mesh first = io::read_mesh(files.front());
+  CgalSequence sequence(first.positions, first.triangles);
+  size_t total = 0;
+  for (const auto& file : files) {
+    const mesh::Mesh frame = io::read_mesh(file);
+    sequence.set_positions(frame.positions);
+    const Pairs pairs = sequence.self_intersections();
+    ASSERT_EQ(pairs, cgal_self_intersections(frame.positions, frame.triangles)) << file;
+    total += pairs.size();
+  }
+  EXPECT_GT(total, 0u);
+}
+
 struct DataFile {
   const char* path;
   size_t triangles;

@@ -65,11 +65,15 @@ bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
 
 }  // namespace
 
-std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
-                                                                 std::span<const geom::Tri> triangles) {
+struct CgalSequence::State {
   Mesh mesh;
-  for (const geom::Vec3d& p : positions) mesh.add_vertex(point_of(p));
   std::vector<int32_t> triangle_of_face;
+};
+
+CgalSequence::CgalSequence(std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles)
+    : state_(std::make_unique<State>()) {
+  Mesh& mesh = state_->mesh;
+  for (const geom::Vec3d& p : positions) mesh.add_vertex(point_of(p));
   for (size_t t = 0; t < triangles.size(); ++t) {
     const geom::Tri& tri = triangles[t];
     if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] || degenerate(positions, tri)) continue;
@@ -78,15 +82,31 @@ std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const
     if (face == Mesh::null_face())
       throw InternalError("triangle " + std::to_string(t) + " cannot join CGAL's halfedge mesh (non-manifold or "
                           "inconsistently oriented)");
-    triangle_of_face.push_back(static_cast<int32_t>(t));
+    state_->triangle_of_face.push_back(static_cast<int32_t>(t));
   }
+}
+
+CgalSequence::~CgalSequence() = default;
+
+void CgalSequence::set_positions(std::span<const geom::Vec3d> positions) {
+  Mesh& mesh = state_->mesh;
+  for (size_t v = 0; v < positions.size(); ++v) mesh.point(Mesh::Vertex_index(static_cast<uint32_t>(v))) = point_of(positions[v]);
+}
+
+std::vector<std::pair<int32_t, int32_t>> CgalSequence::self_intersections() const {
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
-  CGAL::Polygon_mesh_processing::self_intersections<CGAL::Parallel_if_available_tag>(mesh, std::back_inserter(found));
+  CGAL::Polygon_mesh_processing::self_intersections<CGAL::Sequential_tag>(state_->mesh, std::back_inserter(found));
   std::vector<std::pair<int32_t, int32_t>> pairs;
   pairs.reserve(found.size());
-  for (const auto& [f, g] : found) pairs.emplace_back(triangle_of_face[f.idx()], triangle_of_face[g.idx()]);
+  for (const auto& [f, g] : found)
+    pairs.emplace_back(state_->triangle_of_face[f.idx()], state_->triangle_of_face[g.idx()]);
   sort_pairs(pairs);
   return pairs;
+}
+
+std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
+                                                                 std::span<const geom::Tri> triangles) {
+  return CgalSequence(positions, triangles).self_intersections();
 }
 
 std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(std::span<const geom::Vec3d> positions,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <utility>
 #include <vector>
@@ -11,12 +12,35 @@
 
 namespace snag::validators {
 
-/// Intersecting triangle pairs (a < b, sorted) as CGAL's self_intersections reports them, with
+/// Intersecting triangle pairs (a < b, sorted) as CGAL's self_intersections reports them (its
+/// default, sequential), with
 /// the triangles' shared vertices taken from their ids. Zero-area triangles are left out
 /// (snag reports them apart). Throws snag::InternalError when the triangles do not form a
 /// mesh CGAL's halfedge structure can hold; then use `cgal_soup_self_intersections`.
 std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
                                                                  std::span<const geom::Tri> triangles);
+
+/// CGAL's self_intersections over a sequence that keeps one topology: the halfedge mesh is
+/// built once and only its points change per frame, so a benchmark times CGAL's own work and
+/// not the construction of its mesh. Faces of zero area in the first frame are left out for
+/// the whole sequence (as cgal_self_intersections leaves them out of one frame).
+class CgalSequence {
+ public:
+  /// Throws snag::InternalError when the triangles do not form a halfedge mesh.
+  CgalSequence(std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
+  ~CgalSequence();
+  CgalSequence(const CgalSequence&) = delete;
+  CgalSequence& operator=(const CgalSequence&) = delete;
+
+  /// Moves the mesh's vertices to this frame's positions (same count as at construction).
+  void set_positions(std::span<const geom::Vec3d> positions);
+  /// The intersecting pairs (triangle ids, a < b, sorted) of the current positions.
+  std::vector<std::pair<int32_t, int32_t>> self_intersections() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// The same rules (shared edge: coplanar and folded onto each other; shared vertex: the
 /// opposite edge of one meets the other; else CGAL::do_intersect) decided pair by pair with
