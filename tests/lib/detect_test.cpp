@@ -5,79 +5,10 @@
 
 #include <random>
 
-#include "detect_fixture.h"
+#include "detect_cases.h"
 
 namespace snag::test {
 namespace {
-
-/// Every pair of non-degenerate triangles, decided straight from the definition (an edge of
-/// either meets the other beyond their shared endpoints; a duplicated face always), with the
-/// exact integer predicates: no tree, no representative triangles, no filter.
-std::vector<detect::FacePair> brute_force(const SmallMesh& mesh) {
-  const IntegerPredicates pred{mesh.positions.data()};
-  const auto n = static_cast<int32_t>(mesh.triangles.size());
-  std::vector<uint8_t> degenerate(static_cast<size_t>(n));
-  for (int32_t t = 0; t < n; ++t) {
-    const geom::Tri& tri = mesh.triangles[t];
-    degenerate[t] = IntegerResolver::decide(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
-  }
-  auto edge_hits = [&](const geom::Tri& f, const geom::Tri& x) {
-    for (int k = 0; k < 3; ++k) {
-      const int32_t p = f.v[k], q = f.v[(k + 1) % 3];
-      const bool p_in = p == x.v[0] || p == x.v[1] || p == x.v[2], q_in = q == x.v[0] || q == x.v[1] || q == x.v[2];
-      if (p_in && q_in) continue;
-      if (IntegerResolver::decide(geom::edge_hits_triangle(pred, p, q, x, IntegerResolver::side(pred, x, p),
-                                                           IntegerResolver::side(pred, x, q))))
-        return true;
-    }
-    return false;
-  };
-  std::vector<detect::FacePair> pairs;
-  for (int32_t a = 0; a < n; ++a) {
-    if (degenerate[a]) continue;
-    for (int32_t b = a + 1; b < n; ++b) {
-      if (degenerate[b]) continue;
-      const geom::Tri &fa = mesh.triangles[a], &fb = mesh.triangles[b];
-      int shared = 0;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) shared += fa.v[i] == fb.v[j];
-      if (shared == 3 || edge_hits(fa, fb) || edge_hits(fb, fa)) {
-        const bool crossing = IntegerResolver::decide(geom::is_crossing(pred, fa, fb));
-        pairs.push_back({a, b, crossing ? detect::PairKind::crossing : detect::PairKind::touching});
-      }
-    }
-  }
-  return pairs;
-}
-
-/// A triangle soup on a coarse integer lattice: coincident vertices, coplanar and collinear
-/// configurations, shared ids (a vertex pool smaller than 3n) and zero-area faces all occur.
-SmallMesh lattice_soup(int32_t triangles, int32_t vertices, int range, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> coord(0, range);
-  std::uniform_int_distribution<int32_t> pick(0, vertices - 1);
-  SmallMesh mesh;
-  for (int32_t v = 0; v < vertices; ++v) mesh.positions.push_back({double(coord(rng)), double(coord(rng)), double(coord(rng))});
-  for (int32_t t = 0; t < triangles; ++t) mesh.triangles.push_back({{pick(rng), pick(rng), pick(rng)}});
-  return mesh;
-}
-
-/// A folded grid: a w x h sheet whose rows bend back through the sheet, in integer coordinates.
-SmallMesh folded_grid(int w, int h) {
-  SmallMesh mesh;
-  for (int j = 0; j <= h; ++j)
-    for (int i = 0; i <= w; ++i) {
-      const int fold = (i * 3) % (2 * w);  // zig-zag in x: the sheet passes through itself
-      mesh.positions.push_back({double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)});
-    }
-  auto id = [&](int i, int j) { return j * (w + 1) + i; };
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      mesh.triangles.push_back({{id(i, j), id(i + 1, j), id(i + 1, j + 1)}});
-      mesh.triangles.push_back({{id(i, j), id(i + 1, j + 1), id(i, j + 1)}});
-    }
-  return mesh;
-}
 
 TEST(Detect, MatchesBruteForceOnLatticeSoups) {
   for (uint32_t seed = 1; seed <= 40; ++seed) {

@@ -4,76 +4,10 @@
 
 #include <random>
 
-#include "detect_fixture.h"
+#include "detect_cases.h"
 
 namespace snag::test {
 namespace {
-
-using detect::FacePair;
-using detect::PairKind;
-constexpr PairKind kCrossing = PairKind::crossing;
-constexpr PairKind kTouching = PairKind::touching;
-
-struct Case {
-  const char* name;
-  SmallMesh mesh;
-  std::vector<FacePair> pairs;
-  std::vector<int32_t> degenerate;
-};
-
-std::vector<Case> cases() {
-  std::vector<Case> all;
-  // A base triangle F in z = 0 with corners 0, 1, 2.
-  const std::vector<geom::Vec3d> base = {{0, 0, 0}, {8, 0, 0}, {0, 8, 0}};
-  auto with = [&](std::vector<geom::Vec3d> more) {
-    std::vector<geom::Vec3d> p = base;
-    p.insert(p.end(), more.begin(), more.end());
-    return p;
-  };
-  all.push_back({"shared edge folded flat", {with({{4, 4, 0}}), {{{0, 1, 2}}, {{0, 1, 3}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"shared edge flat continuation", {with({{4, -4, 0}}), {{{0, 1, 2}}, {{1, 0, 3}}}}, {}, {}});
-  all.push_back({"shared edge hinge", {with({{4, 4, 5}}), {{{0, 1, 2}}, {{0, 1, 3}}}}, {}, {}});
-  all.push_back({"shared vertex, opposite edge piercing",
-                 {with({{2, 2, -2}, {2, 2, 2}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {{0, 1, kCrossing}}, {}});
-  all.push_back({"shared vertex only", {with({{-2, -2, 3}, {-3, 1, 4}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {}, {}});
-  all.push_back({"shared vertex, edge lying in the face",
-                 {with({{2, 2, 0}, {1, 1, 5}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"shared vertex, coplanar outside the angle",
-                 {with({{-2, -2, 0}, {-4, 1, 0}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {}, {}});
-  all.push_back({"coplanar overlap", {with({{1, 1, 0}, {12, 1, 0}, {1, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"coplanar, one inside the other", {with({{1, 1, 0}, {3, 1, 0}, {1, 3, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"coplanar apart", {with({{9, 9, 0}, {12, 9, 0}, {9, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {}, {}});
-  all.push_back({"vertex exactly on the face", {with({{2, 2, 0}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"vertex exactly on an edge", {with({{4, 0, 0}, {5, -1, 4}, {4, 1, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"vertex a hair above the face", {with({{2, 2, 1}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {}, {}});
-  all.push_back({"edge exactly through an edge",
-                 {with({{4, -2, 0}, {4, 2, 0}, {4, 0, 6}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
-  // X's edge 3-4 crosses F's edge 0-1 at (4, 0, 0), and X meets F's plane along a segment
-  // that leaves F there: both straddle, contact at one point.
-  all.push_back({"edge across an edge at a point",
-                 {with({{4, -2, -2}, {4, 2, 2}, {6, -4, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"segment contact without passing through",
-                 {with({{1, 1, 0}, {3, 1, 0}, {2, 1, 5}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"proper crossing", {with({{1, 1, -3}, {3, 1, 3}, {2, 4, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kCrossing}}, {}});
-  // Both straddle, and the two segments on the planes' line meet only at an end: (4, 0, 0).
-  all.push_back({"straddling, segments meet at one point",
-                 {with({{4, -4, -4}, {4, -4, 4}, {4, 0, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"duplicated face", {base, {{{0, 1, 2}}, {{1, 2, 0}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"zero-area face through a triangle",
-                 {with({{1, 1, -3}, {2, 2, 0}, {3, 3, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {}, {1}});
-  all.push_back({"repeated corner", {with({{1, 1, -3}}), {{{0, 1, 2}}, {{3, 3, 0}}}}, {}, {1}});
-  return all;
-}
-
-const int kIdentity[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-const int kShear[3][3] = {{1, 2, 0}, {0, 1, 3}, {1, 0, 1}};       // det 7
-const int kMirror[3][3] = {{0, 1, 0}, {1, 0, 0}, {-2, 3, 1}};  // det -1: a reflection
 
 void expect_case(const Case& c, const int m[3][3], geom::Vec3d offset, int threads) {
   const SmallMesh mesh = transformed(c.mesh, m, offset);

@@ -1,0 +1,71 @@
+// The CUDA backend: the paper's complete BVH built, refit and traversed on the GPU, with the
+// same per-node, per-leaf and per-pair functions as the CPU backend (snag/bvh, snag/geom,
+// snag/detect headers), so that both give the same FilteredFrame for every input.
+//
+// This header has no CUDA types: the CLI and the tests include it with a plain C++ compiler.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "snag/detect/backend.h"
+#include "snag/geom/box.h"
+#include "snag/geom/vec3.h"
+
+namespace snag::cuda {
+
+/// Number of CUDA devices usable here: 0 when there is no driver, no device, or the driver is
+/// too old for this build. Never throws for that.
+int cuda_device_count();
+
+/// Device-side time of the last run of each stage, in milliseconds, from CUDA events recorded
+/// on the backend's stream around the stage's kernels and copies (host gaps inside a stage,
+/// such as waiting for a count, are included).
+struct StageTimes {
+  double upload = 0;    ///< positions: pinned host buffer to device
+  double scan = 0;      ///< degenerate-triangle scan, with its result back on the host
+  double build = 0;     ///< the whole GPU build, boxes included
+  double refit = 0;     ///< boxes from the current positions
+  double quality = 0;   ///< tree quality, back on the host
+  double traverse = 0;  ///< traversal with the filtered narrow phase, counts back on the host
+  double classify = 0;  ///< hits expanded to pairs, sorted, unique, classified, copied back
+};
+
+/// The CUDA backend with what the benchmark and the tests need beyond detect::Backend.
+class CudaBackend : public detect::Backend {
+ public:
+  /// Times of the last run of each stage (see StageTimes).
+  virtual StageTimes last_times() const = 0;
+  /// Keeps `frames` (each vertex_count positions) on the device, so that select_device_frame
+  /// can make one of them current without crossing the bus. Replaces earlier resident frames.
+  virtual void upload_resident_frames(std::span<const std::span<const geom::Vec3d>> frames) = 0;
+  /// Makes resident frame `index` the current positions (no copy).
+  virtual void select_resident_frame(int index) = 0;
+  /// The initial capacity, in entries, of each result buffer (hits, uncertain tests, duplicated
+  /// faces). A frame that finds more grows the buffers to what it found and traverses again, so
+  /// this changes speed, never results; tests set it small to exercise the growth.
+  virtual void set_result_capacity(int64_t entries) = 0;
+  /// Refit strategy: one launch in which each leaf's thread climbs while it is the second child
+  /// to arrive (an atomic counter per node; the default), or one launch per level.
+  virtual void set_level_by_level_refit(bool on) = 0;
+  /// Records a CUDA event on the backend's stream: the start of a span timed by stop_timer().
+  virtual void start_timer() = 0;
+  /// Milliseconds on the backend's stream since start_timer(), host gaps included (every stage
+  /// ends by waiting for its results, so this is the wall time of the calls in between).
+  virtual double stop_timer() = 0;
+  /// The leaf-to-triangle permutation of the current tree (copied back; for tests).
+  virtual std::vector<int32_t> triangle_order() = 0;
+  /// The node boxes of the current tree, breadth-first (copied back; for tests).
+  virtual std::vector<geom::Box3f> node_boxes() = 0;
+  /// The device's name, as the driver reports it.
+  virtual std::string device_name() const = 0;
+};
+
+/// The CUDA backend on device `device` (0-based). Throws snag::UsageError when there is no such
+/// device, snag::InternalError when a CUDA call fails.
+std::unique_ptr<detect::Backend> make_cuda_backend(int device = 0);
+
+}  // namespace snag::cuda

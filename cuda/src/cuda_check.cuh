@@ -1,0 +1,29 @@
+// Every CUDA call is checked: a failure throws snag::InternalError with the file, the line, the
+// call and CUDA's own message (cli/main.cpp turns it into exit status 4). Nothing here exits.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <string>
+
+#include "snag/error.h"
+
+namespace snag::cuda {
+
+[[noreturn]] inline void throw_cuda_error(cudaError_t status, const char* what, const char* file, int line) {
+  throw InternalError(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
+                      cudaGetErrorName(status) + ": " + cudaGetErrorString(status));
+}
+
+}  // namespace snag::cuda
+
+/// Throws snag::InternalError when `expr` (a CUDA runtime call) does not return cudaSuccess.
+#define SNAG_CUDA_CHECK(expr)                                                     \
+  do {                                                                            \
+    const cudaError_t snag_cuda_status_ = (expr);                                 \
+    if (snag_cuda_status_ != cudaSuccess)                                         \
+      ::snag::cuda::throw_cuda_error(snag_cuda_status_, #expr, __FILE__, __LINE__); \
+  } while (0)
+
+/// After every kernel launch: a bad configuration shows at once, a fault at the next sync.
+#define SNAG_CUDA_CHECK_LAUNCH() SNAG_CUDA_CHECK(cudaGetLastError())

@@ -1,0 +1,124 @@
+// Owning device and pinned host buffers (RAII). Allocation happens when a topology or a
+// sequence starts, or when a result buffer must grow; never per frame otherwise.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <utility>
+
+#include "cuda_check.cuh"
+
+namespace snag::cuda {
+
+/// A device array of T. Growing discards the contents (callers fill it again).
+template <class T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  explicit DeviceBuffer(size_t count) { reserve(count); }
+  ~DeviceBuffer() { release(); }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  DeviceBuffer(DeviceBuffer&& other) noexcept { swap(other); }
+  DeviceBuffer& operator=(DeviceBuffer&& other) noexcept {
+    swap(other);
+    return *this;
+  }
+
+  /// Makes room for at least `count` elements; contents are lost when it reallocates.
+  void reserve(size_t count) {
+    if (count <= capacity_) return;
+    release();
+    SNAG_CUDA_CHECK(cudaMalloc(&data_, count * sizeof(T)));
+    capacity_ = count;
+  }
+  void swap(DeviceBuffer& other) noexcept {
+    std::swap(data_, other.data_);
+    std::swap(capacity_, other.capacity_);
+  }
+  T* data() const { return data_; }
+  size_t capacity() const { return capacity_; }
+
+ private:
+  void release() noexcept {
+    if (data_) cudaFree(data_);  // a destructor cannot throw; a failed free leaks at worst
+    data_ = nullptr;
+    capacity_ = 0;
+  }
+  T* data_ = nullptr;
+  size_t capacity_ = 0;
+};
+
+/// A page-locked host array of T, the source and target of asynchronous copies.
+template <class T>
+class PinnedBuffer {
+ public:
+  PinnedBuffer() = default;
+  ~PinnedBuffer() { release(); }
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+
+  void reserve(size_t count) {
+    if (count <= capacity_) return;
+    release();
+    SNAG_CUDA_CHECK(cudaMallocHost(&data_, count * sizeof(T)));
+    capacity_ = count;
+  }
+  T* data() const { return data_; }
+  size_t capacity() const { return capacity_; }
+
+ private:
+  void release() noexcept {
+    if (data_) cudaFreeHost(data_);
+    data_ = nullptr;
+    capacity_ = 0;
+  }
+  T* data_ = nullptr;
+  size_t capacity_ = 0;
+};
+
+/// A stream and a pair of events owned together.
+class Stream {
+ public:
+  Stream() { SNAG_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking)); }
+  ~Stream() {
+    if (stream_) cudaStreamDestroy(stream_);
+  }
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+  cudaStream_t get() const { return stream_; }
+  void synchronize() const { SNAG_CUDA_CHECK(cudaStreamSynchronize(stream_)); }
+
+ private:
+  cudaStream_t stream_ = nullptr;
+};
+
+/// Times work on a stream with two CUDA events: start(), then stop() returns milliseconds
+/// (it waits for the stream to reach the stop event).
+class EventTimer {
+ public:
+  EventTimer() {
+    SNAG_CUDA_CHECK(cudaEventCreate(&start_));
+    SNAG_CUDA_CHECK(cudaEventCreate(&stop_));
+  }
+  ~EventTimer() {
+    cudaEventDestroy(start_);
+    cudaEventDestroy(stop_);
+  }
+  EventTimer(const EventTimer&) = delete;
+  EventTimer& operator=(const EventTimer&) = delete;
+  void start(cudaStream_t stream) { SNAG_CUDA_CHECK(cudaEventRecord(start_, stream)); }
+  double stop(cudaStream_t stream) {
+    SNAG_CUDA_CHECK(cudaEventRecord(stop_, stream));
+    SNAG_CUDA_CHECK(cudaEventSynchronize(stop_));
+    float ms = 0;
+    SNAG_CUDA_CHECK(cudaEventElapsedTime(&ms, start_, stop_));
+    return ms;
+  }
+
+ private:
+  cudaEvent_t start_ = nullptr, stop_ = nullptr;
+};
+
+}  // namespace snag::cuda

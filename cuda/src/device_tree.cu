@@ -1,0 +1,244 @@
+#include "device_tree.cuh"
+
+#include <thrust/iterator/transform_iterator.h>
+
+#include <algorithm>
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include "launch.cuh"
+
+namespace snag::cuda {
+
+namespace {
+
+using bvh::CompleteTree;
+
+/// A key whose unsigned order is the order of the double (finite, -0 == +0).
+__device__ __forceinline__ uint64_t order_key(double x) {
+  if (x == 0.0) x = 0.0;  // -0 and +0 compare equal on the CPU: give them one key
+  const uint64_t bits = static_cast<uint64_t>(__double_as_longlong(x));
+  return (bits & 0x8000000000000000ull) ? ~bits : (bits | 0x8000000000000000ull);
+}
+
+/// The centroid times three (the CPU's sum of corners, same order of additions) and, per axis,
+/// the sort key of its coordinate with the triangle id beside it.
+__global__ void centroid_keys_kernel(mesh::MeshView mesh, geom::Vec3d* centroids, uint64_t* keys, int32_t* ids) {
+  const int32_t n = mesh.triangle_count;
+  const int32_t t = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (t >= n) return;
+  const geom::Tri tri = mesh.triangles[t];
+  const geom::Vec3d c = mesh.positions[tri.v[0]] + mesh.positions[tri.v[1]] + mesh.positions[tri.v[2]];
+  centroids[t] = c;
+  for (int k = 0; k < 3; ++k) {
+    keys[static_cast<size_t>(k) * n + t] = order_key(geom::coord(c, k));
+    ids[static_cast<size_t>(k) * n + t] = t;
+  }
+}
+
+/// The node of `level` whose leaf range holds position p. Position p is level-D slot p when
+/// p < m, else a level-(D - 1) leaf standing for slots 2p - m and 2p - m + 1 (complete_tree.h).
+__device__ __forceinline__ int32_t node_at_level(const CompleteTree& shape, int32_t p, int32_t level) {
+  const int32_t slot = p < shape.deepest_leaves ? p : 2 * p - shape.deepest_leaves;
+  return CompleteTree::level_begin(level) + (slot >> (shape.depth - level));
+}
+
+/// The segment [begin, end) of position p at `level` and where it splits; a leaf (its segment
+/// is one position) splits at its end, so that nothing moves.
+__device__ __forceinline__ void segment_of(const CompleteTree& shape, int32_t p, int32_t level, int32_t& begin,
+                                           int32_t& end, int32_t& split) {
+  const int32_t node = node_at_level(shape, p, level);
+  if (shape.is_leaf(node)) {
+    begin = p;
+    end = split = p + 1;
+    return;
+  }
+  int32_t left_begin;
+  shape.positions_under(node, begin, end);
+  shape.positions_under(2 * node + 1, left_begin, split);
+}
+
+/// One thread per position p of the chosen axis's list: marks the triangle there left when p
+/// is before the split. The bounds come from the ends of the three lists, as the CPU's min/max.
+__global__ void mark_left_kernel(CompleteTree shape, int32_t level, const geom::Vec3d* centroids,
+                                 const int32_t* lists, uint8_t* left) {
+  const int32_t n = shape.leaf_count;
+  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (p >= n) return;
+  int32_t begin, end, split;
+  segment_of(shape, p, level, begin, end, split);
+  if (end - begin == 1) {
+    left[lists[p]] = 1;
+    return;
+  }
+  double extent[3];
+  for (int k = 0; k < 3; ++k) {
+    const int32_t* list = lists + static_cast<size_t>(k) * n;
+    extent[k] = geom::coord(centroids[list[end - 1]], k) - geom::coord(centroids[list[begin]], k);
+  }
+  const int axis = (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
+  left[lists[static_cast<size_t>(axis) * n + p]] = p < split ? 1 : 0;
+}
+
+struct LeftMark {
+  const uint8_t* left;
+  __host__ __device__ int32_t operator()(int32_t triangle) const { return left[triangle]; }
+};
+
+/// One thread per entry of the three lists: the stable partition of its segment by the marks.
+__global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_t* lists, const uint8_t* left,
+                                 const int32_t* scan, int32_t* out) {
+  const int32_t n = shape.leaf_count;
+  const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= 3 * static_cast<int64_t>(n)) return;
+  const int32_t k = static_cast<int32_t>(i / n), p = static_cast<int32_t>(i - static_cast<int64_t>(k) * n);
+  const size_t base = static_cast<size_t>(k) * n;
+  int32_t begin, end, split;
+  segment_of(shape, p, level, begin, end, split);
+  const int32_t t = lists[i];
+  const int32_t left_before = scan[i] - scan[base + begin];  // left marks in [begin, p)
+  const int32_t to = left[t] ? begin + left_before : split + (p - begin - left_before);
+  out[base + to] = t;
+}
+
+__global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh) {
+  const int32_t n = tree.shape.leaf_count;
+  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (p < n) bvh::refit_leaf(tree.shape.leaf_at(p), tree, mesh);
+}
+
+__global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t last) {
+  const int32_t node = first + static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (node < last) bvh::refit_internal(node, tree);
+}
+
+/// One launch: each leaf's thread fits its leaf, then climbs while it is the second child to
+/// arrive at the parent (counter per node). The first to arrive stops; the second finds the
+/// sibling's box complete: the sibling's writer made its box visible (__threadfence) before
+/// its atomicAdd, and the box is read from L2 (__ldcg), past a possibly stale L1 line. The
+/// second arrival resets the counter, so every counter is zero again after the launch.
+__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, uint32_t* counters) {
+  const int32_t n = tree.shape.leaf_count;
+  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (p >= n) return;
+  int32_t node = tree.shape.leaf_at(p);
+  bvh::refit_leaf(node, tree, mesh);
+  while (node > 0) {
+    const int32_t parent = (node - 1) >> 1;
+    __threadfence();
+    if (atomicAdd(&counters[parent], 1u) == 0) return;
+    counters[parent] = 0;
+    geom::Box3f children[2];
+    for (int c = 0; c < 2; ++c) {
+      const float* src = reinterpret_cast<const float*>(tree.boxes + 2 * parent + 1 + c);
+      float* dst = reinterpret_cast<float*>(&children[c]);
+      for (int k = 0; k < 6; ++k) dst[k] = __ldcg(src + k);
+    }
+    tree.boxes[parent] = geom::merge(children[0], children[1]);
+    node = parent;
+  }
+}
+
+/// The CPU's sum, in its order (node 0, 1, 2, ...): one warp loads and measures 32 nodes at a
+/// time, and every lane adds them in order, so the double sum is bit-identical.
+__global__ void quality_kernel(const geom::Box3f* boxes, int32_t internal, double* out) {
+  const int lane = static_cast<int>(threadIdx.x);
+  double sum = 0.0;
+  for (int32_t base = 0; base < internal; base += 32) {
+    const int32_t node = base + lane;
+    const double area = node < internal ? geom::half_area(boxes[node]) : 0.0;
+    const int count = min(32, internal - base);
+    for (int j = 0; j < count; ++j) sum += __shfl_sync(0xffffffffu, area, j);
+  }
+  if (lane == 0) {
+    const double root = geom::half_area(boxes[0]);
+    *out = root > 0.0 ? sum / root : 0.0;
+  }
+}
+
+}  // namespace
+
+void DeviceTree::resize(int32_t n) {
+  shape_ = n > 0 ? CompleteTree(n) : CompleteTree();
+  if (n <= capacity_) return;
+  const size_t count = static_cast<size_t>(n);
+  boxes_.reserve(2 * count - 1);
+  triangle_at_.reserve(count);
+  refit_counters_.reserve(count);
+  SNAG_CUDA_CHECK(cudaMemset(refit_counters_.data(), 0, count * sizeof(uint32_t)));
+  centroids_.reserve(count);
+  lists_.reserve(3 * count);
+  lists_alt_.reserve(3 * count);
+  left_.reserve(count);
+  scan_.reserve(3 * count);
+  keys_.reserve(3 * count);
+  keys_alt_.reserve(3 * count);
+  ids_.reserve(3 * count);
+  quality_.reserve(1);
+  quality_host_.reserve(1);
+  // Scratch for the sorts and the scans, sized for the largest of them.
+  size_t sort_bytes = 0, scan_bytes = 0;
+  SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys_.data(), keys_alt_.data(), ids_.data(),
+                                                  lists_.data(), n));
+  auto marks = thrust::make_transform_iterator(lists_.data(), LeftMark{left_.data()});
+  SNAG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, marks, scan_.data(), 3 * n));
+  temp_.reserve(std::max(sort_bytes, scan_bytes));
+  capacity_ = n;
+}
+
+void DeviceTree::build(mesh::MeshView mesh, cudaStream_t stream) {
+  const int32_t n = mesh.triangle_count;
+  resize(n);
+  if (n == 0) return;
+  const size_t count = static_cast<size_t>(n);
+  launch(centroid_keys_kernel, n, stream, mesh, centroids_.data(), keys_.data(), ids_.data());
+  for (int k = 0; k < 3; ++k) {
+    // Stable: equal coordinates keep the ids' increasing order, the CPU's tie-break.
+    size_t bytes = temp_.capacity();
+    SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys_.data() + k * count,
+                                                    keys_alt_.data() + k * count, ids_.data() + k * count,
+                                                    lists_.data() + k * count, n, 0, 64, stream));
+  }
+  for (int32_t level = 0; level < shape_.depth; ++level) {
+    launch(mark_left_kernel, n, stream, shape_, level, centroids_.data(), lists_.data(), left_.data());
+    size_t bytes = temp_.capacity();
+    auto marks = thrust::make_transform_iterator(lists_.data(), LeftMark{left_.data()});
+    SNAG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, marks, scan_.data(), 3 * n, stream));
+    launch(partition_kernel, 3 * n, stream, shape_, level, lists_.data(), left_.data(), scan_.data(),
+           lists_alt_.data());
+    lists_.swap(lists_alt_);
+  }
+  // Every list holds the leaf order now; the first one becomes the permutation.
+  SNAG_CUDA_CHECK(cudaMemcpyAsync(triangle_at_.data(), lists_.data(), count * sizeof(int32_t),
+                                  cudaMemcpyDeviceToDevice, stream));
+  refit(mesh, stream);
+}
+
+void DeviceTree::refit(mesh::MeshView mesh, cudaStream_t stream) {
+  const int32_t n = shape_.leaf_count;
+  if (n == 0) return;
+  const bvh::TreeView tree = view();
+  if (!level_by_level_refit) {
+    launch(refit_climb_kernel, n, stream, tree, mesh, refit_counters_.data());
+    return;
+  }
+  launch(refit_leaves_kernel, n, stream, tree, mesh);
+  for (int32_t level = shape_.depth - 1; level >= 0; --level) {
+    const int32_t first = CompleteTree::level_begin(level);
+    const int32_t last = std::min(CompleteTree::level_begin(level + 1), n - 1);
+    if (last > first) launch(refit_level_kernel, last - first, stream, tree, first, last);
+  }
+}
+
+double DeviceTree::quality(cudaStream_t stream) {
+  const int32_t internal = shape_.leaf_count - 1;
+  if (internal <= 0) return 0.0;
+  quality_kernel<<<1, 32, 0, stream>>>(boxes_.data(), internal, quality_.data());
+  SNAG_CUDA_CHECK_LAUNCH();
+  SNAG_CUDA_CHECK(cudaMemcpyAsync(quality_host_.data(), quality_.data(), sizeof(double), cudaMemcpyDeviceToHost,
+                                  stream));
+  SNAG_CUDA_CHECK(cudaStreamSynchronize(stream));
+  return *quality_host_.data();
+}
+
+}  // namespace snag::cuda

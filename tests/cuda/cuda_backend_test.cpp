@@ -1,0 +1,330 @@
+// The CUDA backend against the CPU backend and brute force: the same tree (permutation and
+// boxes, bit for bit), the same filtered frames (pairs, certain kinds, uncertain tests, counts),
+// the same checked frames, on hand-built cases, lattice soups, folded grids, deformed sequences,
+// frames with more results than the buffers first hold, and the shared data files.
+// Without a GPU every test skips with a loud message (CI has nvcc but no GPU).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "detect_cases.h"
+#include "snag/bvh/tree.h"
+#include "snag/cuda/cuda_backend.h"
+#include "snag/detect/cpu_backend.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "test_paths.h"
+
+namespace snag::test {
+namespace {
+
+#define SNAG_REQUIRE_GPU()                                                               \
+  do {                                                                                   \
+    if (cuda::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device: GPU test skipped"; \
+  } while (0)
+
+std::unique_ptr<cuda::CudaBackend> gpu_backend() {
+  std::unique_ptr<detect::Backend> backend = cuda::make_cuda_backend(0);
+  auto* gpu = dynamic_cast<cuda::CudaBackend*>(backend.get());
+  if (!gpu) throw std::logic_error("make_cuda_backend did not make a cuda::CudaBackend");
+  backend.release();
+  return std::unique_ptr<cuda::CudaBackend>(gpu);
+}
+
+/// Runs one frame through a backend the way the checker does, filter only.
+struct Filtered {
+  detect::DegeneracyScan scan;
+  double quality = 0;
+  detect::FilteredFrame frame;
+};
+
+Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positions, bool build) {
+  Filtered f;
+  backend.set_positions(positions);
+  f.scan = backend.scan_degenerate();
+  if (build) backend.build();
+  else backend.refit();
+  f.quality = backend.tree_quality();
+  f.frame = backend.detect(f.scan.degenerate);
+  return f;
+}
+
+void expect_same(const Filtered& cpu, const Filtered& gpu, const std::string& what) {
+  EXPECT_EQ(cpu.scan.degenerate, gpu.scan.degenerate) << what;
+  EXPECT_EQ(cpu.scan.uncertain, gpu.scan.uncertain) << what;
+  EXPECT_EQ(cpu.quality, gpu.quality) << what;  // bit for bit
+  EXPECT_EQ(cpu.frame.pairs, gpu.frame.pairs) << what;
+  EXPECT_EQ(cpu.frame.kind_certain, gpu.frame.kind_certain) << what;
+  EXPECT_EQ(cpu.frame.uncertain, gpu.frame.uncertain) << what;
+  EXPECT_EQ(cpu.frame.candidate_pairs, gpu.frame.candidate_pairs) << what;
+  EXPECT_EQ(cpu.frame.filtered_tests, gpu.frame.filtered_tests) << what;
+}
+
+/// Both backends on one mesh, one frame, from a fresh build.
+void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_t capacity = 0) {
+  const detect::Topology topology = detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  auto cpu = detect::make_cpu_backend(2);
+  auto gpu = gpu_backend();
+  if (capacity > 0) gpu->set_result_capacity(capacity);
+  cpu->set_topology(topology);
+  gpu->set_topology(topology);
+  expect_same(filtered(*cpu, mesh.positions, true), filtered(*gpu, mesh.positions, true), what);
+}
+
+detect::FrameResult check_on_gpu(const SmallMesh& mesh) {
+  detect::Checker checker(gpu_backend(), std::make_shared<IntegerResolver>());
+  checker.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  return checker.check(mesh.positions);
+}
+
+/// A soup of n random triangles in a 10-unit cube (non-integer coordinates: the filter decides).
+SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> where(0.0, 10.0), offset(-size, size);
+  SmallMesh soup;
+  for (int32_t t = 0; t < n; ++t) {
+    const geom::Vec3d c{where(rng), where(rng), where(rng)};
+    for (int k = 0; k < 3; ++k) soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
+    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+  }
+  return soup;
+}
+
+TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
+  SNAG_REQUIRE_GPU();
+  auto gpu = gpu_backend();
+  std::vector<int32_t> sizes;
+  for (int32_t n = 1; n <= 300; ++n) sizes.push_back(n);
+  for (int32_t n : {511, 512, 513, 1000, 1023, 1024, 1025, 4097, 10000, 65537, 200000}) sizes.push_back(n);
+  for (int32_t n : sizes) {
+    const uint32_t seed = 7000 + static_cast<uint32_t>(n);
+    // Coarse coordinates: many equal centroid coordinates, so ties are broken by id often.
+    SmallMesh soup = random_soup(n, seed, 0.5);
+    if (n % 3 == 0)
+      for (auto& p : soup.positions) p = {std::round(p.x), std::round(p.y * 2) / 2, std::round(p.z)};
+    if (n % 5 == 0)
+      for (auto& p : soup.positions) p.x = -p.x;  // negative coordinates, -0 among them
+    const mesh::MeshView view = mesh::view_of(soup.positions, soup.triangles);
+    bvh::Tree cpu_tree;
+    cpu_tree.build(view, 2);
+    const detect::Topology topology = detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    gpu->set_topology(topology);
+    gpu->set_positions(soup.positions);
+    gpu->build();
+    ASSERT_EQ(gpu->triangle_order(), cpu_tree.triangle_at()) << "n=" << n << " seed=" << seed;
+    const std::vector<geom::Box3f> boxes = gpu->node_boxes();
+    ASSERT_EQ(boxes.size(), cpu_tree.boxes().size());
+    ASSERT_EQ(std::memcmp(boxes.data(), cpu_tree.boxes().data(), boxes.size() * sizeof(geom::Box3f)), 0) << "n=" << n;
+    ASSERT_EQ(gpu->tree_quality(), cpu_tree.quality()) << "n=" << n;
+  }
+}
+
+TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
+  SNAG_REQUIRE_GPU();
+  for (int32_t n : {1, 2, 3, 77, 1000, 33333}) {
+    SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
+    const detect::Topology topology = detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    bvh::Tree cpu_tree;
+    cpu_tree.build(mesh::view_of(soup.positions, soup.triangles), 2);
+    for (bool level_by_level : {false, true}) {
+      auto gpu = gpu_backend();
+      gpu->set_level_by_level_refit(level_by_level);
+      gpu->set_topology(topology);
+      gpu->set_positions(soup.positions);
+      gpu->build();
+      SmallMesh moved = soup;
+      std::mt19937 rng(5 + static_cast<uint32_t>(n));
+      std::uniform_real_distribution<double> move(-2.0, 2.0);
+      for (int frame = 0; frame < 3; ++frame) {
+        for (auto& p : moved.positions) p = p + geom::Vec3d{move(rng), move(rng), move(rng)};
+        bvh::Tree cpu_copy = cpu_tree;
+        cpu_copy.refit(mesh::view_of(moved.positions, moved.triangles), 2);
+        gpu->set_positions(moved.positions);
+        gpu->refit();
+        const std::vector<geom::Box3f> boxes = gpu->node_boxes();
+        ASSERT_EQ(std::memcmp(boxes.data(), cpu_copy.boxes().data(), boxes.size() * sizeof(geom::Box3f)), 0)
+            << "n=" << n << " level_by_level=" << level_by_level << " frame " << frame;
+      }
+    }
+  }
+}
+
+TEST(CudaDetect, HandBuiltCasesMatchTheCpuAndTheExpectedPairs) {
+  SNAG_REQUIRE_GPU();
+  for (const Case& c : cases()) {
+    for (const auto& [m, offset] : {std::pair{&kIdentity, geom::Vec3d{0, 0, 0}}, std::pair{&kShear, geom::Vec3d{3, -5, 7}},
+                                    std::pair{&kMirror, geom::Vec3d{-1000, 77, 5}}}) {
+      const SmallMesh mesh = transformed(c.mesh, *m, offset);
+      expect_same_filtered(mesh, c.name);
+      const detect::FrameResult result = check_on_gpu(mesh);
+      EXPECT_EQ(result.pairs, c.pairs) << c.name;
+      EXPECT_EQ(result.degenerate, c.degenerate) << c.name;
+    }
+  }
+}
+
+TEST(CudaDetect, LatticeSoupsMatchTheCpuAndBruteForce) {
+  SNAG_REQUIRE_GPU();
+  for (uint32_t seed = 1; seed <= 40; ++seed) {
+    const int32_t n = 20 + static_cast<int32_t>(seed * 7 % 90);
+    const SmallMesh mesh = lattice_soup(n, n + static_cast<int32_t>(seed % 3) * n, 3 + static_cast<int>(seed % 5), seed);
+    expect_same_filtered(mesh, "seed " + std::to_string(seed));
+    ASSERT_EQ(check_on_gpu(mesh).pairs, brute_force(mesh)) << "seed " << seed;
+    ASSERT_EQ(check_on_gpu(mesh).pairs, check_mesh(mesh, 2).pairs) << "seed " << seed;
+  }
+}
+
+TEST(CudaDetect, FoldedGridsMatchTheCpuAndBruteForce) {
+  SNAG_REQUIRE_GPU();
+  for (auto [w, h] : {std::pair{6, 4}, std::pair{11, 7}, std::pair{17, 9}, std::pair{40, 30}}) {
+    const SmallMesh mesh = folded_grid(w, h);
+    const std::vector<detect::FacePair> expected = brute_force(mesh);
+    ASSERT_FALSE(expected.empty());
+    expect_same_filtered(mesh, std::to_string(w) + "x" + std::to_string(h));
+    EXPECT_EQ(check_on_gpu(mesh).pairs, expected) << w << "x" << h;
+  }
+}
+
+TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
+  SNAG_REQUIRE_GPU();
+  // A folded grid has hundreds of hits and uncertain tests; buffers of 1 and 7 entries must grow.
+  const SmallMesh mesh = folded_grid(30, 20);
+  for (int64_t capacity : {1, 7, 100}) expect_same_filtered(mesh, "capacity " + std::to_string(capacity), capacity);
+  // Overlapping coplanar copies: every pair intersects, 44,850 pairs from a 1-entry start.
+  SmallMesh stack;
+  for (int i = 0; i < 300; ++i) {
+    const int32_t base = static_cast<int32_t>(stack.positions.size());
+    stack.positions.push_back({double(i), double(i), 0});
+    stack.positions.push_back({1000.0 + i, double(i), 0});
+    stack.positions.push_back({double(i), 1000.0 + i, 0});
+    stack.triangles.push_back({{base, base + 1, base + 2}});
+  }
+  expect_same_filtered(stack, "coplanar stack", 1);
+  auto gpu = gpu_backend();
+  gpu->set_result_capacity(1);
+  detect::Checker checker(std::move(gpu), std::make_shared<IntegerResolver>());
+  checker.set_triangles(stack.triangles, static_cast<int32_t>(stack.positions.size()));
+  const detect::FrameResult result = checker.check(stack.positions);
+  EXPECT_EQ(result.pairs.size(), 300u * 299u / 2u);
+  EXPECT_EQ(result.pairs, brute_force(stack));
+}
+
+TEST(CudaDetect, RefitMatchesRebuildTheCpuAndBruteForceAfterDeformation) {
+  SNAG_REQUIRE_GPU();
+  SmallMesh mesh = folded_grid(15, 10);
+  auto resolver = std::make_shared<IntegerResolver>();
+  detect::Checker refitting(gpu_backend(), resolver, {detect::RebuildPolicy::never});
+  detect::Checker rebuilding(gpu_backend(), resolver, {detect::RebuildPolicy::always});
+  detect::Checker cpu(detect::make_cpu_backend(2), resolver, {detect::RebuildPolicy::never});
+  for (detect::Checker* c : {&refitting, &rebuilding, &cpu})
+    c->set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  std::mt19937 rng(99);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int frame = 0; frame < 8; ++frame) {
+    const detect::FrameResult a = refitting.check(mesh.positions);
+    const detect::FrameResult b = rebuilding.check(mesh.positions);
+    const detect::FrameResult c = cpu.check(mesh.positions);
+    EXPECT_EQ(a.pairs, b.pairs) << "frame " << frame;
+    EXPECT_EQ(a.pairs, c.pairs) << "frame " << frame;
+    EXPECT_EQ(a.pairs, brute_force(mesh)) << "frame " << frame;
+    EXPECT_EQ(a.degenerate, c.degenerate) << "frame " << frame;
+    EXPECT_EQ(a.candidate_pairs, c.candidate_pairs) << "frame " << frame;
+    EXPECT_EQ(a.filtered_tests, c.filtered_tests) << "frame " << frame;
+    EXPECT_EQ(a.uncertain_tests, c.uncertain_tests) << "frame " << frame;
+    EXPECT_EQ(a.tree_quality, c.tree_quality) << "frame " << frame;
+    for (auto& p : mesh.positions) p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+  }
+}
+
+TEST(CudaDetect, DegenerateFacesComeAndGoBetweenFrames) {
+  SNAG_REQUIRE_GPU();
+  // Frames that flatten some triangles to zero area and restore them: ownership moves to the
+  // next incident face and back, and the device flags must follow.
+  SmallMesh mesh = folded_grid(12, 8);
+  const detect::Topology topology = detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  auto cpu = detect::make_cpu_backend(2);
+  auto gpu = gpu_backend();
+  cpu->set_topology(topology);
+  gpu->set_topology(topology);
+  for (int frame = 0; frame < 4; ++frame) {
+    SmallMesh moved = mesh;
+    if (frame % 2 == 1) {
+      // Collapse the first triangle of every other row: its third corner onto its first (zero
+      // area the filter certifies: every projected difference is exactly zero).
+      for (int t = 0; t < static_cast<int>(moved.triangles.size()); t += 48) {
+        const geom::Tri tri = moved.triangles[t];
+        moved.positions[tri.v[2]] = moved.positions[tri.v[0]];
+      }
+    }
+    const Filtered c = filtered(*cpu, moved.positions, frame == 0);
+    const Filtered g = filtered(*gpu, moved.positions, frame == 0);
+    if (frame % 2 == 1) EXPECT_FALSE(c.scan.degenerate.empty());
+    expect_same(c, g, "frame " + std::to_string(frame));
+    EXPECT_EQ(check_on_gpu(moved).pairs, brute_force(moved)) << "frame " << frame;
+  }
+}
+
+TEST(CudaDetect, RandomSoupsWithFilterDecisionsMatchTheCpu) {
+  SNAG_REQUIRE_GPU();
+  for (auto [n, size] : {std::pair{1000, 0.5}, std::pair{20000, 0.3}, std::pair{100000, 0.1}}) {
+    const SmallMesh soup = random_soup(n, static_cast<uint32_t>(n), size);
+    expect_same_filtered(soup, "soup " + std::to_string(n));
+  }
+}
+
+TEST(CudaDetect, SharedDataFilesMatchTheCpu) {
+  SNAG_REQUIRE_GPU();
+  const std::filesystem::path data = data_dir();
+  if (data.empty()) GTEST_SKIP() << "no shared data folder (../shared/data): data test skipped";
+  int files = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(data)) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".ply" && ext != ".obj")) continue;
+    const mesh::Mesh m = io::read_mesh(entry.path());
+    SmallMesh mesh{m.positions, m.triangles};
+    expect_same_filtered(mesh, entry.path().string());
+    ++files;
+  }
+  EXPECT_GT(files, 10);
+}
+
+TEST(CudaBackend, EmptyAndSingleTriangleMeshes) {
+  SNAG_REQUIRE_GPU();
+  SmallMesh empty;
+  empty.positions = {{0, 0, 0}};
+  EXPECT_TRUE(check_on_gpu(empty).pairs.empty());
+  SmallMesh one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{{0, 1, 2}}}};
+  EXPECT_TRUE(check_on_gpu(one).pairs.empty());
+  expect_same_filtered(one, "one triangle");
+}
+
+TEST(CudaBackend, ResidentFramesGiveTheSameResultsAsUploadedOnes) {
+  SNAG_REQUIRE_GPU();
+  SmallMesh a = folded_grid(20, 10), b = a;
+  for (auto& p : b.positions) p = p + geom::Vec3d{0, 0, std::fmod(p.x * 7, 3.0)};
+  const detect::Topology topology = detect::make_topology(a.triangles, static_cast<int32_t>(a.positions.size()));
+  auto uploaded = gpu_backend(), resident = gpu_backend();
+  uploaded->set_topology(topology);
+  resident->set_topology(topology);
+  const std::vector<std::span<const geom::Vec3d>> frames = {a.positions, b.positions};
+  resident->upload_resident_frames(frames);
+  for (int f : {0, 1, 0}) {
+    resident->select_resident_frame(f);
+    resident->build();
+    const detect::FilteredFrame r = resident->detect({});
+    const Filtered u = filtered(*uploaded, f == 0 ? a.positions : b.positions, true);
+    EXPECT_EQ(r.pairs, u.frame.pairs) << f;
+    EXPECT_EQ(r.uncertain, u.frame.uncertain) << f;
+  }
+}
+
+TEST(CudaBackend, BadDeviceIsAnError) {
+  SNAG_REQUIRE_GPU();
+  EXPECT_THROW(cuda::make_cuda_backend(cuda::cuda_device_count()), snag::InternalError);
+  EXPECT_THROW(cuda::make_cuda_backend(-1), snag::InternalError);
+}
+
+}  // namespace
+}  // namespace snag::test

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# One round on a GPU machine, from the repository root, with the build staged by
+# ../shared/gpu/stage into .gpu (see tests/cuda/README in the final report):
+#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick]
+# Logs go to $OUT (or ./out); a short table is printed last.
+set -uo pipefail
+out=${OUT:-out}; mkdir -p "$out"
+source .gpu/env.sh
+export SNAG_DATA_DIR=${SNAG_DATA_DIR:-$PWD/.gpu/extra/data}
+steps=("$@"); [ ${#steps[@]} -gt 0 ] || steps=(tests sanitize reports bench)
+summary=()
+nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+for step in "${steps[@]}"; do
+  t0=$(date +%s)
+  case $step in
+    tests)
+      snag_cuda_tests --gtest_brief=1 >"$out/cuda_tests.log" 2>&1; rc=$?
+      summary+=("cuda tests        rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cuda_tests.log" | tr '\n' ' ')")
+      grep -E '^\[  FAILED  \]' "$out/cuda_tests.log" | head -20
+      SNAG_EXECUTABLE=$(command -v snag) snag_cli_tests --gtest_brief=1 >"$out/cli_tests.log" 2>&1; rc=$?
+      summary+=("cli tests         rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cli_tests.log" | tr '\n' ' ')")
+      ;;
+    sanitize)
+      filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
+      for tool in memcheck racecheck; do
+        compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 --gtest_filter="$filter" \
+          >"$out/sanitize_$tool.log" 2>&1; rc=$?
+        summary+=("$tool         rc=$rc $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitize_$tool.log" | tail -1) $(grep -E '^\[  (PASSED|FAILED) ' "$out/sanitize_$tool.log" | tr '\n' ' ')")
+      done
+      ;;
+    reports)
+      # Every sample and shared-data file checked on both backends: the reports must agree.
+      rm -rf /tmp/rep; mkdir -p /tmp/rep; n=0; bad=0
+      inputs=(samples/drape $(find "$SNAG_DATA_DIR" -name '*.ply' | sort))
+      for input in "${inputs[@]}"; do
+        n=$((n+1))
+        for b in cpu cuda; do snag check "$input" --backend $b --out /tmp/rep/$n-$b --quiet >/dev/null 2>>"$out/reports.log"; echo "$input $b rc=$?" >>"$out/reports.log"; done
+        python3 - "$input" /tmp/rep/$n-cpu /tmp/rep/$n-cuda >>"$out/reports.log" 2>&1 || bad=$((bad+1)) <<'PY'
+import json, sys, csv, io
+name, a, b = sys.argv[1:]
+def frames(d):
+    rows = list(csv.reader(open(d + '/frames.csv')))
+    drop = rows[0].index('seconds') if 'seconds' in rows[0] else None
+    return [[c for i, c in enumerate(r) if i != drop] for r in rows]
+def report(d):
+    j = json.load(open(d + '/report.json'))
+    def strip(x):
+        if isinstance(x, dict):
+            return {k: strip(v) for k, v in x.items() if k not in ('seconds', 'times', 'backend', 'threads', 'created', 'elapsed_seconds')}
+        if isinstance(x, list):
+            return [strip(v) for v in x]
+        return x
+    return strip(j)
+same = open(a + '/pairs.csv').read() == open(b + '/pairs.csv').read() and frames(a) == frames(b) and report(a) == report(b)
+print(name, 'same' if same else 'DIFFERENT')
+sys.exit(0 if same else 1)
+PY
+      done
+      summary+=("reports           $n inputs, $bad differ between cpu and cuda")
+      ;;
+    bench)
+      snag bench gpu --data "$SNAG_DATA_DIR" >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
+      summary+=("bench gpu         rc=$rc")
+      ;;
+    bench-quick)
+      snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
+      summary+=("bench gpu (quick) rc=$rc")
+      ;;
+  esac
+  summary[-1]="${summary[-1]}  [$(( $(date +%s) - t0 )) s]"
+done
+[ -f "$out/bench_gpu.txt" ] && cat "$out/bench_gpu.txt"
+printf '%s\n' "${summary[@]}"
