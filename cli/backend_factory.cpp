@@ -5,16 +5,59 @@
 #include "snag/detect/cpu_backend.h"
 #include "snag/error.h"
 
+#ifdef SNAG_HAVE_CUDA
+#include "snag/cuda/cuda_backend.h"
+#endif
+
 namespace snag::cli {
 
-std::unique_ptr<detect::Backend> make_backend(std::string_view name, int threads) {
-  if (name == "auto" || name == "cpu") return detect::make_cpu_backend(threads);
-  if (name == "cuda")
-    throw UsageError(
-        "--backend cuda: the CUDA backend is not built in this version of snag; use "
-        "--backend cpu (or auto)");
-  throw UsageError("--backend: unknown backend '" + std::string(name) +
-                   "' (expected auto, cpu or cuda)");
+bool cuda_built() {
+#ifdef SNAG_HAVE_CUDA
+  return true;
+#else
+  return false;
+#endif
+}
+
+int cuda_devices() {
+#ifdef SNAG_HAVE_CUDA
+  return cuda::cuda_device_count();
+#else
+  return 0;
+#endif
+}
+
+namespace {
+
+std::unique_ptr<detect::Backend> make_cuda(int device) {
+#ifdef SNAG_HAVE_CUDA
+  const int count = cuda::cuda_device_count();
+  if (count == 0)
+    throw DeviceUnavailable(
+        "--backend cuda: no CUDA device is usable here (no NVIDIA GPU, or no driver for it); "
+        "use --backend cpu (or auto)");
+  if (device < 0 || device >= count)
+    throw DeviceUnavailable("--device " + std::to_string(device) + ": this machine has " + std::to_string(count) +
+                            " CUDA device" + (count == 1 ? "" : "s") + ", numbered from 0");
+  return cuda::make_cuda_backend(device);
+#else
+  (void)device;
+  throw DeviceUnavailable(
+      "--backend cuda: this snag was built without the CUDA backend (no CUDA compiler was found "
+      "when it was built); use --backend cpu (or auto), or rebuild with the CUDA toolkit");
+#endif
+}
+
+}  // namespace
+
+std::unique_ptr<detect::Backend> make_backend(std::string_view name, int threads, int device) {
+  if (name == "cpu") return detect::make_cpu_backend(threads);
+  if (name == "cuda") return make_cuda(device);
+  if (name == "auto") {
+    if (cuda_built() && cuda_devices() > 0) return make_cuda(device);
+    return detect::make_cpu_backend(threads);
+  }
+  throw UsageError("--backend: unknown backend '" + std::string(name) + "' (expected auto, cpu or cuda)");
 }
 
 }  // namespace snag::cli

@@ -2,11 +2,7 @@
 // same frames (generated cloth at the paper's sizes, the shared cloth-ball frames, and any
 // --input sequence), with a check that both found the same pairs. A benchmark, not a test:
 // it prints a table and fails only when the pairs differ.
-#include <fcntl.h>
 #include <omp.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,6 +17,7 @@
 #include <vector>
 
 #include "backend_factory.h"
+#include "bench_support.h"
 #include "commands.h"
 #include "snag/detect/checker.h"
 #include "snag/error.h"
@@ -29,19 +26,12 @@
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/cgal_resolver.h"
 
-extern char** environ;
-
 namespace snag::cli {
 
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-/// Frames simulated before the timed ones, so that the cloth has landed on the sphere and folded
-/// through itself: at the generator's default 30 frames per second, it folds from about frame
-/// 15 and has thousands of intersecting pairs from frame 20 on (samples/README.md).
-constexpr int settle_frames = 24;
 
 struct Case {
   std::string name;
@@ -58,79 +48,6 @@ struct Row {
   bool same = true;
   std::string note;
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/// A temporary directory removed with everything in it when the bench ends.
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() /
-            ("snag-bench-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-/// The sample generator: --generator, else beside this executable (installed layout), else in
-/// the build tree's samples/ (build layout), else `snag-cloth` on PATH.
-std::string find_generator(const BenchOptions& o) {
-  if (!o.generator.empty()) return o.generator;
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (const fs::path& candidate : {self.parent_path() / "snag-cloth",
-                                      self.parent_path().parent_path() / "samples" / "snag-cloth"})
-      if (fs::exists(candidate, ec)) return candidate.string();
-  }
-  return "snag-cloth";
-}
-
-void run_program(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  // The generator's own summary would break up the table: its standard output goes nowhere.
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0)
-    throw UsageError("cannot run the sample generator '" + args[0] +
-                     "' (build it, or give its path with --generator)");
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw InternalError("the sample generator '" + args[0] + "' failed");
-}
-
-std::vector<fs::path> generated_cloth(const BenchOptions& o, int triangles, const fs::path& dir) {
-  const int total = settle_frames + std::max(1, o.frames);
-  std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total
-            << " frames\n";
-  run_program({find_generator(o), "--triangles", std::to_string(triangles), "--frames",
-               std::to_string(total), "--output-dir", dir.string(), "--prefix", "cloth",
-               "--quiet"});
-  std::vector<fs::path> files;
-  for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
-  if (files.size() > static_cast<size_t>(std::max(1, o.frames)))
-    files.erase(files.begin(), files.end() - std::max(1, o.frames));
-  return files;
-}
 
 std::vector<std::pair<int32_t, int32_t>> pair_ids(const detect::FrameResult& r) {
   std::vector<std::pair<int32_t, int32_t>> ids;
@@ -261,14 +178,7 @@ int run_bench_cpu(const BenchOptions& o) {
   ScratchDir scratch;
   std::vector<Case> cases;
 
-  fs::path data = o.data_dir;
-  if (data.empty()) {
-    if (const char* env = std::getenv("SNAG_DATA_DIR"); env && *env) data = env;
-#ifdef SNAG_DATA_DIR_DEFAULT
-    else
-      data = SNAG_DATA_DIR_DEFAULT;
-#endif
-  }
+  const fs::path data = data_folder(o.data_dir);
   const fs::path ball = data / "scalable-ccd" / "cloth-ball";
   if (!data.empty() && fs::is_directory(ball)) {
     Case c{"cloth-ball", {}};
@@ -291,7 +201,7 @@ int run_bench_cpu(const BenchOptions& o) {
   for (int size : o.sizes) {
     if (size <= 0) continue;
     const fs::path dir = scratch.path() / std::to_string(size);
-    generated.push_back({"cloth " + std::to_string(size), generated_cloth(o, size, dir)});
+    generated.push_back({"cloth " + std::to_string(size), generated_cloth(o.generator, size, settle_frames, o.frames, dir)});
   }
   cases.insert(cases.begin(), generated.begin(), generated.end());
   if (cases.empty()) throw UsageError("nothing to time: no --sizes, no data folder, no --input");

@@ -146,10 +146,15 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->check(CLI::Range(1.0, 1e9))
       ->capture_default_str();
   cmd->add_option("--backend", o.backend,
-                  "Detection backend: auto, cpu (cuda: not in this version)")
+                  "Detection backend: auto (the GPU when snag has CUDA and a device is present, else "
+                  "the CPU), cpu, or cuda (exit status 4 when not built or no device)")
       ->type_name("NAME")
       ->check(CLI::IsMember(
           std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))
+      ->capture_default_str();
+  cmd->add_option("--device", o.device, "CUDA device for the cuda backend, numbered from 0")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
       ->type_name("N")
@@ -176,7 +181,7 @@ int run_check(const CheckOptions& o) {
   // once rather than after an hour of checking.
   if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
 
-  auto backend = make_backend(o.backend, o.threads);
+  auto backend = make_backend(o.backend, o.threads, o.device);
   const std::string backend_name(backend->name());
   detect::CheckSettings settings;
   settings.rebuild = rebuild_policy(o.rebuild);

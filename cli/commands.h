@@ -20,6 +20,7 @@ struct CheckOptions {
   std::string rebuild = "auto";
   double rebuild_threshold = 1.5;
   std::string backend = "auto";
+  int device = 0;
   int threads = 0;
   std::string fail_on = "crossing";
   bool quiet = false;
@@ -42,5 +43,23 @@ struct BenchOptions {
 /// Adds `bench` and its `cpu` subcommand; returns the `cpu` subcommand.
 CLI::App* add_bench_command(CLI::App& app, BenchOptions& options);
 int run_bench_cpu(const BenchOptions& options);
+
+/// Options of `snag bench gpu`, filled by CLI11.
+struct BenchGpuOptions {
+  std::vector<int> sizes = {2244, 27030, 35992};
+  int large = 1000000;
+  int frames = 50;
+  int warmup = 5;
+  int cpu_frames = 5;
+  std::string data_dir;
+  std::vector<std::string> inputs;
+  std::string generator;
+  int threads = 0;
+  int device = 0;
+};
+
+/// Adds the `gpu` subcommand to `bench` (the command add_bench_command made); returns it.
+CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& options);
+int run_bench_gpu(const BenchGpuOptions& options);
 
 }  // namespace snag::cli

@@ -2,12 +2,14 @@
 //
 // This file holds the one place where exceptions become exit statuses:
 //   0 clean, 1 intersections found (per --fail-on; returned by the command, not thrown),
-//   2 usage error, 3 input or output error, 4 internal error.
+//   2 usage error, 3 input or output error, 4 internal error or no usable CUDA device when one
+//   was asked for.
 #include <CLI/CLI.hpp>
 
 #include <exception>
 #include <iostream>
 
+#include "backend_factory.h"
 #include "commands.h"
 #include "snag/error.h"
 #include "snag/report/write.h"
@@ -24,6 +26,8 @@ int main(int argc, char** argv) {
     CLI::App* check_command = snag::cli::add_check_command(app, check);
     snag::cli::BenchOptions bench;
     CLI::App* bench_cpu_command = snag::cli::add_bench_command(app, bench);
+    snag::cli::BenchGpuOptions bench_gpu;
+    CLI::App* bench_gpu_command = snag::cli::add_bench_gpu_command(*app.get_subcommand("bench"), bench_gpu);
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
@@ -32,6 +36,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (check_command->parsed()) return snag::cli::run_check(check);
     if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);
+    if (bench_gpu_command->parsed()) return snag::cli::run_bench_gpu(bench_gpu);
     throw snag::InternalError("no subcommand ran");
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.
@@ -46,6 +51,9 @@ int main(int argc, char** argv) {
   } catch (const snag::report::WriteError& e) {
     std::cerr << "snag: cannot write the report: " << e.what() << "\n";
     return 3;
+  } catch (const snag::cli::DeviceUnavailable& e) {
+    std::cerr << "snag: error: " << e.what() << "\n";
+    return 4;
   } catch (const snag::InternalError& e) {
     std::cerr << "snag: internal error: " << e.what() << "\n";
     return 4;

@@ -78,7 +78,10 @@ TEST(CliCheck, HandBuiltSequenceReports) {
 
   const auto j = nlohmann::json::parse(read_text(tmp.path() / "out" / "report.json"));
   EXPECT_EQ(j.at("schema"), "snag-report/1");
-  EXPECT_EQ(j.at("settings").at("backend"), "cpu");
+  // The default backend, auto, is the GPU where snag has CUDA and a device is present.
+  const std::string backend = j.at("settings").at("backend");
+  EXPECT_TRUE(backend == "cpu" || backend == "cuda") << backend;
+  EXPECT_EQ(j.at("settings").at("backend_requested"), "auto");
   EXPECT_EQ(j.at("settings").at("rebuild"), "never");
   EXPECT_EQ(j.at("settings").at("fail_on"), "crossing");
   EXPECT_TRUE(j.at("settings").at("weld").is_null());
@@ -196,12 +199,22 @@ TEST(CliStatus, UsageErrorsExitTwo) {
   }
 }
 
-TEST(CliStatus, CudaBackendIsAClearUsageError) {
+TEST(CliStatus, CudaBackendRunsOrExitsFourWithAReason) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");
   const RunResult r = run_snag({"check", "seq", "--backend", "cuda"}, tmp.path());
-  EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("CUDA backend is not built"), std::string::npos) << r.err;
+  if (r.status == 4) {
+    // Not built with CUDA, or no device here: said plainly.
+    EXPECT_NE(r.err.find("--backend cuda"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.err.find("built without the CUDA backend") != std::string::npos ||
+                r.err.find("no CUDA device") != std::string::npos)
+        << r.err;
+  } else {
+    EXPECT_EQ(r.status, 1) << context(r);  // a GPU is here: the sequence has a crossing
+  }
+  const RunResult bad = run_snag({"check", "seq", "--backend", "cuda", "--device", "999"}, tmp.path());
+  EXPECT_EQ(bad.status, 4) << context(bad);
+  EXPECT_FALSE(bad.err.empty());
 }
 
 TEST(CliStatus, HelpAndVersionExitZero) {
@@ -209,6 +222,7 @@ TEST(CliStatus, HelpAndVersionExitZero) {
   for (const std::vector<std::string>& args : {std::vector<std::string>{"--help"},
                                                {"check", "--help"},
                                                {"bench", "cpu", "--help"},
+                                               {"bench", "gpu", "--help"},
                                                {"--version"}}) {
     const RunResult r = run_snag(args, tmp.path());
     EXPECT_EQ(r.status, 0) << args[0] << "\n" << context(r);
@@ -278,6 +292,7 @@ TEST(CliHelp, AgreesWithTheManPage) {
   const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
       {"snag check", {"check", "--help"}},
       {"snag bench cpu", {"bench", "cpu", "--help"}},
+      {"snag bench gpu", {"bench", "gpu", "--help"}},
   };
   for (const auto& [heading, args] : commands) {
     const std::string section = man_section(man, heading);

@@ -1,0 +1,97 @@
+#include "bench_support.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <iostream>
+#include <random>
+
+#include "snag/error.h"
+#include "snag/seq/sequence.h"
+
+extern char** environ;
+
+namespace snag::cli {
+
+namespace fs = std::filesystem;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+ScratchDir::ScratchDir() {
+  std::random_device rd;
+  path_ = fs::temp_directory_path() / ("snag-bench-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+  fs::create_directories(path_);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ignored;
+  fs::remove_all(path_, ignored);
+}
+
+std::string find_generator(const std::string& given) {
+  if (!given.empty()) return given;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (const fs::path& candidate :
+         {self.parent_path() / "snag-cloth", self.parent_path().parent_path() / "samples" / "snag-cloth"})
+      if (fs::exists(candidate, ec)) return candidate.string();
+  }
+  return "snag-cloth";
+}
+
+namespace {
+
+void run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  // The generator's own summary would break up the table: its standard output goes nowhere.
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0)
+    throw UsageError("cannot run the sample generator '" + args[0] + "' (build it, or give its path with --generator)");
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw InternalError("the sample generator '" + args[0] + "' failed");
+}
+
+}  // namespace
+
+std::vector<fs::path> generated_cloth(const std::string& generator, int triangles, int settle, int keep,
+                                      const fs::path& dir) {
+  keep = std::max(1, keep);
+  const int total = settle + keep;
+  std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total << " frames\n";
+  run_program({find_generator(generator), "--triangles", std::to_string(triangles), "--frames", std::to_string(total),
+               "--output-dir", dir.string(), "--prefix", "cloth", "--quiet"});
+  std::vector<fs::path> files;
+  for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
+  if (files.size() > static_cast<size_t>(keep)) files.erase(files.begin(), files.end() - keep);
+  return files;
+}
+
+fs::path data_folder(const std::string& given) {
+  if (!given.empty()) return given;
+  if (const char* env = std::getenv("SNAG_DATA_DIR"); env && *env) return env;
+#ifdef SNAG_DATA_DIR_DEFAULT
+  return SNAG_DATA_DIR_DEFAULT;
+#else
+  return {};
+#endif
+}
+
+}  // namespace snag::cli

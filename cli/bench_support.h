@@ -1,0 +1,43 @@
+// What the benchmarks share: medians, a scratch directory, the sample generator, the data folder.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace snag::cli {
+
+/// Frames simulated before the timed ones, so that the cloth has landed on the sphere and folded
+/// through itself: at the generator's default 30 frames per second, it folds from about frame
+/// 15 and has thousands of intersecting pairs from frame 20 on (samples/README.md).
+inline constexpr int settle_frames = 24;
+
+double median(std::vector<double> v);
+
+/// A temporary directory removed with everything in it when the bench ends.
+class ScratchDir {
+ public:
+  ScratchDir();
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The sample generator: `given` (--generator) when set, else beside this executable (installed
+/// layout), else in the build tree's samples/ (build layout), else `snag-cloth` on PATH.
+std::string find_generator(const std::string& given);
+
+/// Generates a cloth of about `triangles` triangles into `dir` with `settle` + `keep` frames and
+/// returns the last `keep` frame files.
+std::vector<std::filesystem::path> generated_cloth(const std::string& generator, int triangles, int settle, int keep,
+                                                   const std::filesystem::path& dir);
+
+/// The shared data folder: `given` (--data), else $SNAG_DATA_DIR, else the one known at build
+/// time; empty when none is known.
+std::filesystem::path data_folder(const std::string& given);
+
+}  // namespace snag::cli
