@@ -139,21 +139,18 @@ __global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, uint
   }
 }
 
-/// The CPU's sum, in its order (node 0, 1, 2, ...): one warp loads and measures 32 nodes at a
-/// time, and every lane adds them in order, so the double sum is bit-identical.
-__global__ void quality_kernel(const geom::Box3f* boxes, int32_t internal, double* out) {
-  const int lane = static_cast<int>(threadIdx.x);
-  double sum = 0.0;
-  for (int32_t base = 0; base < internal; base += 32) {
-    const int32_t node = base + lane;
-    const double area = node < internal ? geom::half_area(boxes[node]) : 0.0;
-    const int count = min(32, internal - base);
-    for (int j = 0; j < count; ++j) sum += __shfl_sync(0xffffffffu, area, j);
-  }
-  if (lane == 0) {
-    const double root = geom::half_area(boxes[0]);
-    *out = root > 0.0 ? sum / root : 0.0;
-  }
+/// The quality's block sums, one thread per block of bvh::kQualityBlock internal nodes, each
+/// in the order the CPU adds them (bvh::quality_block_sum).
+__global__ void quality_blocks_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape, int32_t blocks,
+                                      double* block_sums) {
+  const int32_t block = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (block < blocks) block_sums[block] = bvh::quality_block_sum(boxes, shape, block);
+}
+
+/// The block sums in order (bvh::quality_from_blocks): a few dozen additions for 36K triangles.
+__global__ void quality_finish_kernel(const double* block_sums, int32_t blocks, const geom::Box3f* boxes,
+                                      double* out) {
+  *out = bvh::quality_from_blocks(block_sums, blocks, boxes[0]);
 }
 
 }  // namespace
@@ -176,6 +173,7 @@ void DeviceTree::resize(int32_t n) {
   ids_.reserve(3 * count);
   quality_.reserve(1);
   quality_host_.reserve(1);
+  quality_blocks_.reserve(static_cast<size_t>((n + bvh::kQualityBlock - 1) / bvh::kQualityBlock));
   // Scratch for the sorts and the scans, sized for the largest of them.
   size_t sort_bytes = 0, scan_bytes = 0;
   SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys_.data(), keys_alt_.data(), ids_.data(),
@@ -231,9 +229,10 @@ void DeviceTree::refit(mesh::MeshView mesh, cudaStream_t stream) {
 }
 
 double DeviceTree::quality(cudaStream_t stream) {
-  const int32_t internal = shape_.leaf_count - 1;
-  if (internal <= 0) return 0.0;
-  quality_kernel<<<1, 32, 0, stream>>>(boxes_.data(), internal, quality_.data());
+  const int32_t blocks = bvh::quality_block_count(shape_);
+  if (blocks == 0) return 0.0;
+  launch(quality_blocks_kernel, blocks, stream, boxes_.data(), shape_, blocks, quality_blocks_.data());
+  quality_finish_kernel<<<1, 1, 0, stream>>>(quality_blocks_.data(), blocks, boxes_.data(), quality_.data());
   SNAG_CUDA_CHECK_LAUNCH();
   SNAG_CUDA_CHECK(cudaMemcpyAsync(quality_host_.data(), quality_.data(), sizeof(double), cudaMemcpyDeviceToHost,
                                   stream));

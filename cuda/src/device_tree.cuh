@@ -41,8 +41,8 @@ class DeviceTree {
   /// Recomputes every box from `mesh`'s positions. Asynchronous.
   void refit(mesh::MeshView mesh, cudaStream_t stream);
 
-  /// Sum of internal-node half areas over the root's (0 for a single leaf), summed in the
-  /// CPU's order so that it is bit-identical. Waits for the stream.
+  /// Sum of internal-node half areas over the root's (0 for a single leaf), in the blocked
+  /// order of bvh::quality_block_sum, so that it is the CPU's bit for bit. Waits for the stream.
   double quality(cudaStream_t stream);
 
   bool level_by_level_refit = false;
@@ -64,6 +64,7 @@ class DeviceTree {
   DeviceBuffer<int32_t> ids_;
   DeviceBuffer<unsigned char> temp_;
   DeviceBuffer<double> quality_;
+  DeviceBuffer<double> quality_blocks_;  // one sum per bvh::kQualityBlock internal nodes
   PinnedBuffer<double> quality_host_;
   int32_t capacity_ = 0;
 };

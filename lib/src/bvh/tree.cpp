@@ -79,12 +79,11 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
 }
 
 double Tree::quality() const {
-  const int32_t internal = shape_.leaf_count - 1;
-  if (internal <= 0) return 0.0;
-  double sum = 0.0;
-  for (int32_t node = 0; node < internal; ++node) sum += geom::half_area(boxes_[node]);
-  const double root = geom::half_area(boxes_[0]);
-  return root > 0.0 ? sum / root : 0.0;
+  const int32_t blocks = quality_block_count(shape_);
+  if (blocks == 0) return 0.0;
+  std::vector<double> block_sums(static_cast<size_t>(blocks));
+  for (int32_t block = 0; block < blocks; ++block) block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
+  return quality_from_blocks(block_sums.data(), blocks, boxes_[0]);
 }
 
 }  // namespace snag::bvh

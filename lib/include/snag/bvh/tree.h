@@ -67,6 +67,33 @@ SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visi
   }
 }
 
+/// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
+/// GPU runs in parallel: the internal nodes' half areas summed in blocks of kQualityBlock
+/// consecutive nodes, each block in order; then the block sums in order (quality_from_blocks).
+constexpr int32_t kQualityBlock = 1024;
+
+SNAG_HD_INLINE int32_t quality_block_count(const CompleteTree& shape) {
+  return (shape.leaf_count - 1 + kQualityBlock - 1) / kQualityBlock;
+}
+
+/// The sum of block `block`'s internal-node half areas.
+SNAG_HD_INLINE double quality_block_sum(const geom::Box3f* boxes, const CompleteTree& shape, int32_t block) {
+  const int32_t begin = block * kQualityBlock;
+  const int32_t end = begin + kQualityBlock < shape.leaf_count - 1 ? begin + kQualityBlock : shape.leaf_count - 1;
+  double sum = 0.0;
+  for (int32_t node = begin; node < end; ++node) sum += geom::half_area(boxes[node]);
+  return sum;
+}
+
+/// Quality from the block sums: their sum, in order, over the root's half area (0 without an
+/// internal node or for a root of zero area).
+SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t blocks, const geom::Box3f& root) {
+  double sum = 0.0;
+  for (int32_t block = 0; block < blocks; ++block) sum += block_sums[block];
+  const double root_area = geom::half_area(root);
+  return blocks > 0 && root_area > 0.0 ? sum / root_area : 0.0;
+}
+
 /// The level whose nodes group leaves for for_each_later_overlap_grouped: D - 2, where every
 /// node is internal and holds 2 to 4 leaves (those of levels D - 1 and D below it).
 inline int32_t group_level(const CompleteTree& shape) { return shape.depth >= 2 ? shape.depth - 2 : 0; }
@@ -146,7 +173,8 @@ class Tree {
   /// Recomputes every box from the current positions, leaves first, then one level at a
   /// time up to the root, each level in parallel.
   void refit(mesh::MeshView mesh, int threads);
-  /// Sum of internal-node half areas over the root's half area (0 for a single leaf).
+  /// Sum of internal-node half areas over the root's half area (0 for a single leaf), summed
+  /// in the blocked order of quality_block_sum / quality_from_blocks.
   double quality() const;
 
   TreeView view() { return {shape_, boxes_.data(), triangle_at_.data()}; }
