@@ -38,12 +38,7 @@ struct IntegerPredicates {
   int dominant_axis(int32_t a, int32_t b, int32_t c) const {
     return geom::dominant_axis(positions[a], positions[b], positions[c]);
   }
-  struct Plane {
-    const IntegerPredicates* pred;
-    int32_t a, b, c;
-    geom::Sign side(int32_t d) const { return pred->orient3d(a, b, c, d); }
-  };
-  Plane plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
+  geom::OrientPlane<IntegerPredicates> plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
 };
 
 /// Decides uncertain tests with IntegerPredicates (the same decision procedures).

@@ -4,6 +4,7 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include "snag/geom/narrow_phase.h"
 #include "snag/geom/predicates.h"
 
 namespace snag::validators {
@@ -33,12 +34,7 @@ struct CgalPredicates {
   int dominant_axis(int32_t a, int32_t b, int32_t c) const {
     return geom::dominant_axis(positions[a], positions[b], positions[c]);
   }
-  struct Plane {
-    const CgalPredicates* pred;
-    int32_t a, b, c;
-    geom::Sign side(int32_t d) const { return pred->orient3d(a, b, c, d); }
-  };
-  Plane plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
+  geom::OrientPlane<CgalPredicates> plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
 };
 
 }  // namespace snag::validators

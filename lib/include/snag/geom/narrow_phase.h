@@ -29,6 +29,15 @@
 
 namespace snag::geom {
 
+/// plane(a, b, c) for providers that have nothing to precompute per plane (the exact ones):
+/// side(d) asks orient3d(a, b, c, d).
+template <class P>
+struct OrientPlane {
+  const P* pred;
+  int32_t a, b, c;
+  Sign side(int32_t d) const { return pred->orient3d(a, b, c, d); }
+};
+
 /// A three-valued answer: uncertain when a sign the answer depends on was uncertain.
 enum class Answer : int8_t { no = 0, yes = 1, uncertain = 2 };
 
