@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cstring>
 #include <cub/device/device_radix_sort.cuh>
-#include <cub/device/device_select.cuh>
 
 #include "cuda_check.cuh"
 #include "detect_kernels.cuh"
@@ -51,15 +50,21 @@ class CudaBackendImpl final : public CudaBackend {
     SNAG_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
     device_name_ = prop.name;
     stream_ = std::make_unique<Stream>();
+    configure_kernels();
     counters_.reserve(1);
     counters_host_.reserve(1);
-    unique_count_.reserve(2);  // [0]: pairs kept by the unique pass, [1]: the expansion's fill
   }
 
   std::string_view name() const override { return "cuda"; }
   std::string device_name() const override { return device_name_; }
-  StageTimes last_times() const override { return times_; }
-  void set_result_capacity(int64_t entries) override { initial_capacity_ = std::max<int64_t>(entries, 1); }
+  StageTimes last_times() const override {
+    collect_times();  // waits for stages still queued
+    return times_;
+  }
+  void set_result_capacity(int64_t entries) override {
+    initial_capacity_ = std::max<int64_t>(entries, 1);
+    finish_limit_ = std::min<unsigned long long>(kFinishLimit, static_cast<unsigned long long>(initial_capacity_));
+  }
   void set_level_by_level_refit(bool on) override { tree_.level_by_level_refit = on; }
   void start_timer() override { span_timer_.start(stream()); }
   double stop_timer() override { return span_timer_.stop(stream()); }
@@ -86,8 +91,13 @@ class CudaBackendImpl final : public CudaBackend {
     d.degenerate_list.reserve(std::max<size_t>(n, 1));
     if (n) SNAG_CUDA_CHECK(cudaMemsetAsync(d.degenerate.data(), 0, n, s));
     flagged_.clear();
-    scan_degenerate_.reserve(std::max<size_t>(n, 1));
-    scan_uncertain_.reserve(std::max<size_t>(n, 1));
+    scan_degenerate_host_.reserve(std::max<size_t>(n, 1));
+    scan_uncertain_host_.reserve(std::max<size_t>(n, 1));
+    host_keys_.reserve(kFinishLimit);
+    host_status_.reserve(kFinishLimit);
+    host_uncertain_.reserve(kFinishLimit);
+    host_results_ = {mapped(host_keys_.data()), mapped(host_status_.data()), mapped(host_uncertain_.data()),
+                     mapped(counters_host_.data()), 0};
     planes_.reserve(std::max<size_t>(n, 1));
     positions_.reserve(std::max<int32_t>(d.vertex_count, 1));
     positions_host_.reserve(std::max<int32_t>(d.vertex_count, 1));
@@ -95,7 +105,9 @@ class CudaBackendImpl final : public CudaBackend {
     pair_bits_ = bits_for(d.triangle_count);
     edge_bits_ = bits_for(d.edge_count);
     tree_.resize(d.triangle_count);
-    ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_);
+    tree_built_ = false;
+    quality_ready_ = false;
+    ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_, initial_capacity_);
     stream_->synchronize();
   }
 
@@ -104,13 +116,17 @@ class CudaBackendImpl final : public CudaBackend {
     if (static_cast<int64_t>(positions.size()) != topo_.vertex_count)
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
-    // The previous upload from the pinned buffer finished: every stage ends with a sync.
+    // The pinned buffer is free once the previous upload is done (detect and scan end with a
+    // sync, so this wait is empty in a checker's frame).
+    if (upload_pending_) upload_timer_.elapsed();
     std::memcpy(positions_host_.data(), positions.data(), positions.size_bytes());
-    timer_.start(stream());
+    upload_timer_.start(stream());
     SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_.data(), positions_host_.data(), positions.size_bytes(),
                                     cudaMemcpyHostToDevice, stream()));
-    times_.upload = timer_.stop(stream());
+    upload_timer_.stop_async(stream());
+    upload_pending_ = true;
     current_positions_ = positions_.data();
+    ++positions_version_;
   }
 
   void upload_resident_frames(std::span<const std::span<const geom::Vec3d>> frames) override {
@@ -128,8 +144,12 @@ class CudaBackendImpl final : public CudaBackend {
   void select_resident_frame(int index) override {
     if (index < 0 || index >= resident_count_) throw InternalError("cuda backend: no resident frame " + std::to_string(index));
     current_positions_ = resident_.data() + static_cast<size_t>(index) * static_cast<size_t>(topo_.vertex_count);
+    ++positions_version_;
   }
 
+  /// The scan, and ahead of the refit() and tree_quality() calls that follow it in a checker's
+  /// frame: the refit and the quality, queued before the scan's one wait (refit() and
+  /// tree_quality() then find them done). A build() in between makes them moot, not wrong.
   detect::DegeneracyScan scan_degenerate() override {
     require_topology();
     const int32_t n = topo_.triangle_count;
@@ -138,18 +158,25 @@ class CudaBackendImpl final : public CudaBackend {
     const cudaStream_t s = stream();
     timer_.start(s);
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    launch_scan_degenerate(current_positions_, topo_.triangles.data(), n, scan_degenerate_.data(),
-                           scan_uncertain_.data(), counters_.data(), s);
-    const FrameCounters c = read_counters();
-    scan.degenerate.resize(c.degenerate);
-    scan.uncertain.resize(c.degenerate_uncertain);
-    if (c.degenerate)
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(scan.degenerate.data(), scan_degenerate_.data(), c.degenerate * sizeof(int32_t),
-                                      cudaMemcpyDeviceToHost, s));
-    if (c.degenerate_uncertain)
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(scan.uncertain.data(), scan_uncertain_.data(),
-                                      c.degenerate_uncertain * sizeof(int32_t), cudaMemcpyDeviceToHost, s));
-    times_.scan = timer_.stop(s);
+    launch_scan_degenerate(current_positions_, topo_.triangles.data(), n, mapped(scan_degenerate_host_.data()),
+                           mapped(scan_uncertain_host_.data()), counters_.data(), s);
+    SNAG_CUDA_CHECK(cudaMemcpyAsync(counters_host_.data(), counters_.data(), sizeof(FrameCounters),
+                                    cudaMemcpyDeviceToHost, s));
+    const bool ahead = tree_built_ && tree_positions_ != positions_version_;
+    if (ahead) {
+      queue_refit();
+      tree_.queue_quality(s);
+    }
+    timer_.stop_async(s);
+    times_.scan = timer_.elapsed();  // the wait: scan, refit and quality done
+    collect_times();
+    if (ahead) {
+      quality_ = tree_.queued_quality();
+      quality_ready_ = true;
+    }
+    const FrameCounters c = *counters_host_.data();
+    scan.degenerate.assign(scan_degenerate_host_.data(), scan_degenerate_host_.data() + c.degenerate);
+    scan.uncertain.assign(scan_uncertain_host_.data(), scan_uncertain_host_.data() + c.degenerate_uncertain);
     // Appended in any order: sorted as the CPU gives them.
     std::sort(scan.degenerate.begin(), scan.degenerate.end());
     std::sort(scan.uncertain.begin(), scan.uncertain.end());
@@ -158,27 +185,42 @@ class CudaBackendImpl final : public CudaBackend {
 
   void build() override {
     require_topology();
-    timer_.start(stream());
-    tree_.build(mesh_view(), stream());
-    times_.build = timer_.stop(stream());
+    build_timer_.start(stream());
+    tree_.build(mesh_view(), planes_.data(), stream());
+    build_timer_.stop_async(stream());
+    build_pending_ = true;
+    tree_built_ = true;
+    tree_positions_ = positions_version_;
+    planes_positions_ = positions_version_;
+    quality_ready_ = false;
   }
 
+  /// Skipped when the tree already fits the current positions (refit ahead in the scan, or a
+  /// build): times().refit is then 0, its time being in the scan's.
   void refit() override {
     require_topology();
-    timer_.start(stream());
-    tree_.refit(mesh_view(), stream());
-    times_.refit = timer_.stop(stream());
+    if (tree_built_ && tree_positions_ == positions_version_) {
+      times_.refit = 0;
+      return;
+    }
+    queue_refit();
   }
 
   double tree_quality() override {
     require_topology();
+    if (quality_ready_) return quality_;
     timer_.start(stream());
-    const double q = tree_.quality(stream());
-    times_.quality = timer_.stop(stream());
-    return q;
+    tree_.queue_quality(stream());
+    timer_.stop_async(stream());
+    times_.quality = timer_.elapsed();
+    collect_times();
+    quality_ = tree_.queued_quality();
+    quality_ready_ = true;
+    return quality_;
   }
 
   std::vector<int32_t> triangle_order() override {
+    stream_->synchronize();  // a build may still be queued
     std::vector<int32_t> order(static_cast<size_t>(tree_.shape().leaf_count));
     if (!order.empty())
       SNAG_CUDA_CHECK(cudaMemcpy(order.data(), tree_.view().triangle_at, order.size() * sizeof(int32_t),
@@ -187,6 +229,7 @@ class CudaBackendImpl final : public CudaBackend {
   }
 
   std::vector<geom::Box3f> node_boxes() override {
+    stream_->synchronize();  // a build or a refit may still be queued
     const int32_t n = tree_.shape().leaf_count;
     std::vector<geom::Box3f> boxes(n > 0 ? static_cast<size_t>(2 * n - 1) : 0);
     if (!boxes.empty())
@@ -208,18 +251,39 @@ class CudaBackendImpl final : public CudaBackend {
     return {current_positions_, topo_.triangles.data(), topo_.vertex_count, topo_.triangle_count};
   }
 
-  FrameCounters read_counters() {
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(counters_host_.data(), counters_.data(), sizeof(FrameCounters),
-                                    cudaMemcpyDeviceToHost, stream()));
-    stream_->synchronize();
-    return *counters_host_.data();
+  void queue_refit() {
+    refit_timer_.start(stream());
+    tree_.refit(mesh_view(), planes_.data(), stream());
+    refit_timer_.stop_async(stream());
+    refit_pending_ = true;
+    tree_positions_ = positions_version_;
+    planes_positions_ = positions_version_;
+    quality_ready_ = false;
   }
 
-  void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates) {
+  /// Stage times whose stop events the stream has passed (called after a wait).
+  void collect_times() const {
+    if (upload_pending_) times_.upload = upload_timer_.elapsed();
+    if (build_pending_) times_.build = build_timer_.elapsed();
+    if (refit_pending_) times_.refit = refit_timer_.elapsed();
+    upload_pending_ = build_pending_ = refit_pending_ = false;
+  }
+
+  /// Result buffers for at least these counts. Never shrinks, so a sequence allocates only
+  /// while its counts grow; the pair set's table is a power of two at least twice the pairs.
+  void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates, uint64_t pairs) {
     hits_.reserve(hits);
     uncertain_.reserve(uncertain);
     duplicates_.reserve(duplicates);
+    pair_keys_.reserve(pairs);
+    pair_status_.reserve(pairs);
+    uint64_t table = 1;
+    while (table < 2 * pairs) table <<= 1;
+    table_.reserve(table);
   }
+
+  /// With some slack, so that a sequence whose counts creep up does not run every frame twice.
+  static uint64_t grown(uint64_t count) { return count + count / 2 + 1024; }
 
   /// The frame's degenerate flags and edge ownership on the device.
   const uint8_t* prepare_degenerate(std::span<const int32_t> degenerate);
@@ -229,7 +293,7 @@ class CudaBackendImpl final : public CudaBackend {
   std::string device_name_;
   std::unique_ptr<Stream> stream_;
   EventTimer timer_, span_timer_;
-  StageTimes times_;
+  mutable StageTimes times_;
   const detect::Topology* topology_ = nullptr;
   DeviceTopology topo_;
   DeviceTree tree_;
@@ -238,18 +302,30 @@ class CudaBackendImpl final : public CudaBackend {
   const geom::Vec3d* current_positions_ = nullptr;
   int resident_count_ = 0;
   DeviceBuffer<geom::PlaneCoefficients> planes_;
-  DeviceBuffer<int32_t> scan_degenerate_, scan_uncertain_;
+  PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
   PinnedBuffer<FrameCounters> counters_host_;
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
-  DeviceBuffer<uint64_t> keys_, keys_alt_, unique_keys_;
-  DeviceBuffer<uint8_t> status_;
-  DeviceBuffer<unsigned long long> unique_count_;
+  // The pair set (PairSet) and the large-frame path's sort buffers.
+  DeviceBuffer<unsigned long long> table_;
+  DeviceBuffer<uint64_t> pair_keys_, keys_alt_, tasks_alt_;
+  DeviceBuffer<uint8_t> pair_status_, status_alt_;
   DeviceBuffer<unsigned char> temp_;
-  PinnedBuffer<uint64_t> keys_host_, uncertain_host_;
-  PinnedBuffer<uint8_t> status_host_;
-  PinnedBuffer<unsigned long long> unique_count_host_;
+  // Results in host memory: written by finish_kernel (small frames) or copied (large ones).
+  PinnedBuffer<uint64_t> host_keys_, host_uncertain_, keys_host_, uncertain_host_;
+  PinnedBuffer<uint8_t> host_status_, status_host_;
+  // Stage timers whose stop may still be queued: read (and waited for) by collect_times().
+  mutable EventTimer upload_timer_, build_timer_, refit_timer_;
+  mutable bool upload_pending_ = false, build_pending_ = false, refit_pending_ = false;
+  EventTimer narrow_timer_;
+  // Which positions the tree and the planes fit: positions_version_ counts set_positions and
+  // select_resident_frame calls.
+  uint64_t positions_version_ = 0, tree_positions_ = ~uint64_t{0}, planes_positions_ = ~uint64_t{0};
+  bool tree_built_ = false, quality_ready_ = false;
+  double quality_ = 0;
+  unsigned long long finish_limit_ = kFinishLimit;
+  HostResults host_results_;  // device addresses of the host_* buffers
   int64_t initial_capacity_ = 1 << 16;
   int pair_bits_ = 1, edge_bits_ = 1;
 };
@@ -285,7 +361,10 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
   timer_.start(s);
 
   const uint8_t* owned = prepare_degenerate(degenerate);
-  launch_planes(current_positions_, topo_.triangles.data(), n, planes_.data(), s);
+  if (planes_positions_ != positions_version_) {
+    launch_planes(current_positions_, topo_.triangles.data(), n, planes_.data(), s);
+    planes_positions_ = positions_version_;
+  }
   PairInputs inputs;
   inputs.frame = {current_positions_, planes_.data()};
   inputs.topology.triangles = topo_.triangles.data();
@@ -297,8 +376,14 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
   inputs.topology.triangle_count = n;
   inputs.topology.edge_count = topo_.edge_count;
   inputs.degenerate = topo_.degenerate.data();
+  const int key_bits = 2 * pair_bits_;
+  const int task_bits = 32 + edge_bits_;
+  FrameCounters* host_counters = counters_host_.data();
 
-  // Traverse; when a buffer overflowed, grow it to what was found and traverse again.
+  // The whole frame is queued before the one wait: narrow phase, expansion into the pair set,
+  // and (when the frame's results fit one block) the sort straight into host memory. Buffers
+  // are sized by earlier frames; when one overflowed, the counts say by how much: grow, run
+  // again. No pair is lost, and a sequence allocates only while its counts grow.
   FrameCounters c{};
   for (;;) {
     ResultBuffers results;
@@ -310,109 +395,117 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     results.duplicate_capacity = duplicates_.capacity();
     results.counters = counters_.data();
     results.edge_face_offsets = topo_.edge_face_offsets.data();
+    PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(), pair_keys_.capacity()};
+    HostResults out = host_results_;
+    out.limit = finish_limit_;
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
+    SNAG_CUDA_CHECK(cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
     launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(), topo_.neighbor_pair_count, results, s);
-    c = read_counters();
-    if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() && c.duplicates <= duplicates_.capacity())
+    narrow_timer_.stop_async(s);
+    launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(), counters_.data(),
+                  topo_.edge_face_offsets.data(), topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_,
+                  current_positions_, topo_.triangles.data(), set, s);
+    launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), key_bits, task_bits, out, s);
+    timer_.stop_async(s);
+    timer_.elapsed();  // the wait
+    c = *host_counters;
+    if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() && c.duplicates <= duplicates_.capacity() &&
+        c.pairs <= pair_keys_.capacity())
       break;
-    ensure_result_capacity(c.hits, c.uncertain, c.duplicates);
+    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits.
+    ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates), grown(c.expanded + c.duplicates));
+    timer_.start(s);
   }
-  times_.traverse = timer_.stop(s);
+  collect_times();
+  {
+    float ms = 0;
+    SNAG_CUDA_CHECK(cudaEventElapsedTime(&ms, timer_.start_event(), narrow_timer_.stop_event()));
+    times_.traverse = ms;
+  }
+  times_.classify = timer_.elapsed() - times_.traverse;
   frame.traverse_seconds = seconds_since(start);
   frame.candidate_pairs = static_cast<int64_t>(c.candidates);
 
   const auto classify_start = Clock::now();
-  timer_.start(s);
-  const unsigned long long slots = c.expanded + c.duplicates;
-  const uint64_t sentinel = ~uint64_t{0};
-  const int key_bits = 2 * pair_bits_;
-  const int task_bits = 32 + edge_bits_;
-  // Every buffer and the scratch are sized before anything is queued: nothing queued may see
-  // a buffer reallocated under it.
-  {
-    const size_t alt = std::max<size_t>(std::max<size_t>(slots, c.uncertain), 1);
-    keys_.reserve(std::max<size_t>(slots, 1));
-    keys_alt_.reserve(alt);
-    unique_keys_.reserve(std::max<size_t>(slots, 1));
-    status_.reserve(std::max<size_t>(slots, 1));
-    keys_host_.reserve(std::max<size_t>(slots, 1));
-    status_host_.reserve(std::max<size_t>(slots, 1));
-    uncertain_host_.reserve(std::max<size_t>(c.uncertain, 1));
-    unique_count_host_.reserve(1);
+  // Frames too large for one block: CUB's device-wide sorts, now that the counts are known.
+  const bool large_pairs = c.pairs > finish_limit_, large_tasks = c.uncertain > finish_limit_;
+  const uint64_t* keys = host_keys_.data();
+  const uint8_t* statuses = host_status_.data();
+  const uint64_t* tasks = host_uncertain_.data();
+  if (large_pairs || large_tasks) {
+    timer_.start(s);
+    keys_alt_.reserve(std::max<size_t>(c.pairs, 1));
+    status_alt_.reserve(std::max<size_t>(c.pairs, 1));
+    tasks_alt_.reserve(std::max<size_t>(c.uncertain, 1));
     size_t need = 0, bytes = 0;
-    cub::DoubleBuffer<uint64_t> pairs(keys_.data(), keys_alt_.data()), tasks(uncertain_.data(), keys_alt_.data());
-    if (slots) {
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(nullptr, bytes, pairs, static_cast<int64_t>(slots), 0, key_bits, s));
-      need = std::max(need, bytes);
-      SNAG_CUDA_CHECK(cub::DeviceSelect::Unique(nullptr, bytes, keys_.data(), unique_keys_.data(), unique_count_.data(),
-                                                static_cast<int64_t>(slots), s));
+    if (large_pairs) {
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, pair_keys_.data(), keys_alt_.data(),
+                                                      pair_status_.data(), status_alt_.data(),
+                                                      static_cast<int64_t>(c.pairs), 0, key_bits, s));
       need = std::max(need, bytes);
     }
-    if (c.uncertain) {
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(nullptr, bytes, tasks, static_cast<int64_t>(c.uncertain), 0,
-                                                     task_bits, s));
+    if (large_tasks) {
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(nullptr, bytes, uncertain_.data(), tasks_alt_.data(),
+                                                     static_cast<int64_t>(c.uncertain), 0, task_bits, s));
       need = std::max(need, bytes);
     }
     temp_.reserve(std::max<size_t>(need, 1));
+    if (large_pairs) {
+      keys_host_.reserve(c.pairs);
+      status_host_.reserve(c.pairs);
+      bytes = temp_.capacity();
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, pair_keys_.data(), keys_alt_.data(),
+                                                      pair_status_.data(), status_alt_.data(),
+                                                      static_cast<int64_t>(c.pairs), 0, key_bits, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(keys_host_.data(), keys_alt_.data(), c.pairs * sizeof(uint64_t),
+                                      cudaMemcpyDeviceToHost, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(status_host_.data(), status_alt_.data(), c.pairs, cudaMemcpyDeviceToHost, s));
+      keys = keys_host_.data();
+      statuses = status_host_.data();
+    }
+    if (large_tasks) {
+      uncertain_host_.reserve(c.uncertain);
+      bytes = temp_.capacity();
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, uncertain_.data(), tasks_alt_.data(),
+                                                     static_cast<int64_t>(c.uncertain), 0, task_bits, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(uncertain_host_.data(), tasks_alt_.data(), c.uncertain * sizeof(uint64_t),
+                                      cudaMemcpyDeviceToHost, s));
+      tasks = uncertain_host_.data();
+    }
+    timer_.stop_async(s);
+    times_.classify += timer_.elapsed();
   }
-  if (slots) {
-    // Pairs: expand the hits, add the duplicated faces, sort, unique, classify. Slots the
-    // expansion leaves empty keep the sentinel, which sorts last.
-    SNAG_CUDA_CHECK(cudaMemsetAsync(keys_.data(), 0xff, slots * sizeof(uint64_t), s));
-    SNAG_CUDA_CHECK(cudaMemsetAsync(unique_count_.data(), 0, 2 * sizeof(unsigned long long), s));
-    launch_expand(hits_.data(), c.hits, duplicates_.data(), c.duplicates, topo_.edge_face_offsets.data(),
-                  topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_, keys_.data(), unique_count_.data() + 1, s);
-    cub::DoubleBuffer<uint64_t> sorted(keys_.data(), keys_alt_.data());
-    size_t bytes = temp_.capacity();
-    SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, sorted, static_cast<int64_t>(slots), 0,
-                                                   key_bits, s));
-    bytes = temp_.capacity();
-    SNAG_CUDA_CHECK(cub::DeviceSelect::Unique(temp_.data(), bytes, sorted.Current(), unique_keys_.data(),
-                                              unique_count_.data(), static_cast<int64_t>(slots), s));
-    launch_classify(unique_keys_.data(), unique_count_.data(), slots, pair_bits_, sentinel, current_positions_,
-                    topo_.triangles.data(), status_.data(), s);
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(unique_count_host_.data(), unique_count_.data(), sizeof(unsigned long long),
-                                    cudaMemcpyDeviceToHost, s));
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(keys_host_.data(), unique_keys_.data(), slots * sizeof(uint64_t),
-                                    cudaMemcpyDeviceToHost, s));
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(status_host_.data(), status_.data(), slots, cudaMemcpyDeviceToHost, s));
-  }
-  if (c.uncertain) {
-    // Uncertain tests sorted by (edge, triangle), the keys' order; the alternate buffer is free
-    // again once the pair sort before it (same stream) is done.
-    cub::DoubleBuffer<uint64_t> sorted(uncertain_.data(), keys_alt_.data());
-    size_t bytes = temp_.capacity();
-    SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, sorted, static_cast<int64_t>(c.uncertain), 0,
-                                                   task_bits, s));
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(uncertain_host_.data(), sorted.Current(), c.uncertain * sizeof(uint64_t),
-                                    cudaMemcpyDeviceToHost, s));
-  }
-  stream_->synchronize();
 
   int64_t uncertain_kinds = 0;
-  if (slots) {
-    unsigned long long count = *unique_count_host_.data();
-    if (count && keys_host_.data()[count - 1] == sentinel) --count;
-    frame.pairs.resize(count);
-    frame.kind_certain.resize(count);
-    const uint64_t mask = (uint64_t{1} << pair_bits_) - 1;
-    for (unsigned long long i = 0; i < count; ++i) {
-      const uint64_t key = keys_host_.data()[i];
-      const uint8_t status = status_host_.data()[i];
-      frame.pairs[i] = {static_cast<int32_t>(key >> pair_bits_), static_cast<int32_t>(key & mask),
-                        static_cast<detect::PairKind>(status & 1)};
-      frame.kind_certain[i] = static_cast<uint8_t>(status >> 1);
-      uncertain_kinds += 1 - (status >> 1);
-    }
+  frame.pairs.resize(c.pairs);
+  frame.kind_certain.resize(c.pairs);
+  const uint64_t mask = (uint64_t{1} << pair_bits_) - 1;
+  for (unsigned long long i = 0; i < c.pairs; ++i) {
+    const uint64_t key = keys[i];
+    const uint8_t status = statuses[i];
+    frame.pairs[i] = {static_cast<int32_t>(key >> pair_bits_), static_cast<int32_t>(key & mask),
+                      static_cast<detect::PairKind>(status & 1)};
+    frame.kind_certain[i] = static_cast<uint8_t>(status >> 1);
+    uncertain_kinds += 1 - (status >> 1);
   }
   frame.uncertain.resize(c.uncertain);
   for (unsigned long long i = 0; i < c.uncertain; ++i) {
-    const uint64_t key = uncertain_host_.data()[i];
+    const uint64_t key = tasks[i];
     frame.uncertain[i] = {static_cast<int32_t>(key >> 32), static_cast<int32_t>(key & 0xffffffffu)};
   }
   frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) + static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
-  times_.classify = timer_.stop(s);
   frame.classify_seconds = seconds_since(classify_start);
+  {
+    // Next frames start with this one's counts and some slack, so that creeping counts
+    // rarely run a frame twice. Only now: growing discards the buffers' contents.
+    const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain), duplicates = grown(c.duplicates),
+                   pairs = grown(c.expanded + c.duplicates);
+    if (hits > hits_.capacity() || uncertain > uncertain_.capacity() || duplicates > duplicates_.capacity() ||
+        pairs > pair_keys_.capacity())
+      ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()), std::max<uint64_t>(uncertain, uncertain_.capacity()),
+                             std::max<uint64_t>(duplicates, duplicates_.capacity()),
+                             std::max<uint64_t>(pairs, pair_keys_.capacity()));
+  }
   return frame;
 }
 

@@ -2,6 +2,8 @@
 
 #include <cooperative_groups.h>
 
+#include <cub/block/block_radix_sort.cuh>
+
 #include "launch.cuh"
 #include "snag/geom/narrow_phase.h"
 
@@ -77,78 +79,148 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
-/// The neighbour pass: one thread per listed pair (their boxes always overlap).
-__global__ void neighbor_pairs_kernel(PairInputs in, const std::array<int32_t, 2>* pairs, int64_t count,
-                                      ResultBuffers out) {
-  const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  DeviceSink sink{out};
-  unsigned long long candidates = 0;
-  if (i < count) {
-    const int32_t t = pairs[i][0], x = pairs[i][1];
-    if (!in.degenerate[t] && !in.degenerate[x]) {
-      ++candidates;
-      detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
-    }
-  }
-  add_warp_total(candidates, &out.counters->candidates);
-  add_warp_total(sink.misses, &out.counters->misses);
-  add_warp_total(sink.expanded, &out.counters->expanded);
+/// One thread's share of the neighbour pass: listed pair i (their boxes always overlap).
+__device__ __forceinline__ void neighbor_pair(const PairInputs& in, const std::array<int32_t, 2>* pairs, int64_t i,
+                                              DeviceSink& sink, unsigned long long& candidates) {
+  const int32_t t = pairs[i][0], x = pairs[i][1];
+  if (in.degenerate[t] || in.degenerate[x]) return;
+  ++candidates;
+  detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
 }
 
-/// The traversal: one thread per leaf position, in leaf order, so that a warp's triangles are
+/// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
 /// neighbours and follow nearly the same path; pairs of the neighbour list are skipped.
-__global__ void traverse_kernel(bvh::TreeView tree, PairInputs in, ResultBuffers out) {
-  const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const PairInputs& in, int32_t position,
+                                              DeviceSink& sink, unsigned long long& candidates) {
+  const int32_t t = tree.triangle_at[position];
+  if (in.degenerate[t]) return;
+  const geom::Tri tt = in.topology.triangles[t];
+  bvh::for_each_later_overlap(tree, position, [&](int32_t x) {
+    if (in.degenerate[x] ||
+        detect::is_listed_neighbor(tt, in.topology.triangles[x], in.topology.listed_vertex,
+                                   in.topology.every_vertex_listed))
+      return;
+    ++candidates;
+    detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
+  });
+}
+
+/// Blocks [0, traverse_blocks) traverse, the rest run the neighbour pass (the branch is uniform
+/// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
+__global__ void __launch_bounds__(kNarrowBlock) narrow_phase_kernel(bvh::TreeView tree, PairInputs in,
+                                                                    const std::array<int32_t, 2>* pairs,
+                                                                    int64_t pair_count, unsigned traverse_blocks,
+                                                                    ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
-  if (position < tree.shape.leaf_count) {
-    const int32_t t = tree.triangle_at[position];
-    if (!in.degenerate[t]) {
-      const geom::Tri tt = in.topology.triangles[t];
-      bvh::for_each_later_overlap(tree, position, [&](int32_t x) {
-        if (in.degenerate[x] || detect::is_listed_neighbor(tt, in.topology.triangles[x], in.topology.listed_vertex,
-                                                              in.topology.every_vertex_listed))
-          return;
-        ++candidates;
-        detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
-      });
-    }
+  if (blockIdx.x < traverse_blocks) {
+    const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+    if (position < tree.shape.leaf_count) traverse_leaf(tree, in, position, sink, candidates);
+  } else {
+    const int64_t i = static_cast<int64_t>(blockIdx.x - traverse_blocks) * blockDim.x + threadIdx.x;
+    if (i < pair_count) neighbor_pair(in, pairs, i, sink, candidates);
   }
   add_warp_total(candidates, &out.counters->candidates);
   add_warp_total(sink.misses, &out.counters->misses);
   add_warp_total(sink.expanded, &out.counters->expanded);
 }
 
-__global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_count, const uint64_t* duplicates,
-                              unsigned long long duplicate_count, const int32_t* offsets, const int32_t* faces,
-                              const uint8_t* degenerate, int bits, uint64_t* keys, unsigned long long* fill) {
+/// Adds pair `key` to the set; the thread that inserts it classifies it and appends it.
+__device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::Vec3d* positions,
+                                            const geom::Tri* triangles, const PairSet& set, FrameCounters* counters) {
+  unsigned long long slot = (key * 0x9E3779B97F4A7C15ull) >> 20 & set.table_mask;
+  for (;;) {
+    const unsigned long long was = atomicCAS(set.table + slot, kEmptyKey, static_cast<unsigned long long>(key));
+    if (was == key) return;  // another thread has it
+    if (was == kEmptyKey) break;
+    slot = (slot + 1) & set.table_mask;
+  }
+  const unsigned long long at = atomicAdd(&counters->pairs, 1ull);
+  if (at >= set.pair_capacity) return;  // counted: the host grows the buffers and runs again
+  const int32_t a = static_cast<int32_t>(key >> bits);
+  const int32_t b = static_cast<int32_t>(key & ((1ull << bits) - 1));
+  const geom::FilteredPredicates pred{positions};
+  const geom::Answer crossing = geom::is_crossing(pred, triangles[a], triangles[b]);
+  set.keys[at] = key;
+  // bit 0: touching (PairKind's value), bit 1: certain
+  set.status[at] =
+      crossing == geom::Answer::uncertain ? uint8_t{1} : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
+}
+
+__global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
+                              unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* offsets,
+                              const int32_t* faces, const uint8_t* degenerate, int bits,
+                              const geom::Vec3d* positions, const geom::Tri* triangles, PairSet set) {
   const unsigned long long i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < hit_count) {
+  // Past a capacity the narrow phase counted without storing: the host runs the frame again.
+  const unsigned long long hit_count = min(counters->hits, hit_capacity);
+  const unsigned long long duplicate_count = min(counters->duplicates, duplicate_capacity);
+  if (i < hit_capacity) {
+    if (i >= hit_count) return;
     const int32_t edge = static_cast<int32_t>(hits[i] >> 32);
     const int32_t triangle = static_cast<int32_t>(hits[i] & 0xffffffffu);
     for (int32_t j = offsets[edge]; j < offsets[edge + 1]; ++j) {
       const int32_t face = faces[j];
       if (face == triangle || degenerate[face]) continue;
       const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) | static_cast<uint64_t>(max(face, triangle));
-      keys[atomicAdd(fill, 1ull)] = key;
+      insert_pair(key, bits, positions, triangles, set, counters);
     }
-  } else if (i < hit_count + duplicate_count) {
-    const uint64_t d = duplicates[i - hit_count];
-    keys[atomicAdd(fill, 1ull)] = ((d >> 32) << bits) | (d & 0xffffffffu);
+  } else if (i - hit_capacity < duplicate_count) {
+    const uint64_t d = duplicates[i - hit_capacity];
+    insert_pair(((d >> 32) << bits) | (d & 0xffffffffu), bits, positions, triangles, set, counters);
   }
 }
 
-__global__ void classify_kernel(const uint64_t* keys, const unsigned long long* count, unsigned long long capacity,
-                                int bits, uint64_t sentinel, const geom::Vec3d* positions, const geom::Tri* triangles,
-                                uint8_t* status) {
-  const unsigned long long i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i >= capacity || i >= *count || keys[i] == sentinel) return;
-  const int32_t a = static_cast<int32_t>(keys[i] >> bits);
-  const int32_t b = static_cast<int32_t>(keys[i] & ((1ull << bits) - 1));
-  const geom::FilteredPredicates pred{positions};
-  const geom::Answer crossing = geom::is_crossing(pred, triangles[a], triangles[b]);
-  // bit 0: touching (PairKind's value), bit 1: certain
-  status[i] = crossing == geom::Answer::uncertain ? uint8_t{1} : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
+using FinishPairSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItems, uint8_t>;
+using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItems>;
+
+/// Shared memory of finish_kernel: more than the static 48 KB, so it is dynamic.
+constexpr size_t kFinishShared = sizeof(typename FinishPairSort::TempStorage) > sizeof(typename FinishTaskSort::TempStorage)
+                                     ? sizeof(typename FinishPairSort::TempStorage)
+                                     : sizeof(typename FinishTaskSort::TempStorage);
+
+/// The frame's results to host memory: small sets sorted in shared memory (keys are distinct,
+/// so the order is total and the block's output is the device-wide sort's), the counters last.
+__global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCounters* counters, PairSet set,
+                                                                const uint64_t* uncertain,
+                                                                unsigned long long uncertain_capacity, int key_bits,
+                                                                int task_bits, HostResults out) {
+  extern __shared__ __align__(16) unsigned char shared[];
+  const FrameCounters c = *counters;
+  const unsigned long long limit = min(out.limit, kFinishLimit);
+  if (c.pairs <= limit && c.pairs <= set.pair_capacity) {
+    uint64_t keys[kFinishItems];
+    uint8_t status[kFinishItems];
+    for (int k = 0; k < kFinishItems; ++k) {
+      const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kFinishItems + k;
+      keys[k] = at < c.pairs ? set.keys[at] : kEmptyKey;  // the empty key sorts last
+      status[k] = at < c.pairs ? set.status[at] : 0;
+    }
+    FinishPairSort(*reinterpret_cast<typename FinishPairSort::TempStorage*>(shared))
+        .SortBlockedToStriped(keys, status, 0, key_bits);
+    for (int k = 0; k < kFinishItems; ++k) {
+      const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+      if (at < c.pairs) {
+        out.keys[at] = keys[k];
+        out.status[at] = status[k];
+      }
+    }
+    __syncthreads();  // the shared memory is the next sort's
+  }
+  if (c.uncertain <= limit && c.uncertain <= uncertain_capacity) {
+    uint64_t keys[kFinishItems];
+    for (int k = 0; k < kFinishItems; ++k) {
+      const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kFinishItems + k;
+      keys[k] = at < c.uncertain ? uncertain[at] : kEmptyKey;
+    }
+    FinishTaskSort(*reinterpret_cast<typename FinishTaskSort::TempStorage*>(shared))
+        .SortBlockedToStriped(keys, 0, task_bits);
+    for (int k = 0; k < kFinishItems; ++k) {
+      const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+      if (at < c.uncertain) out.uncertain[at] = keys[k];
+    }
+  }
+  if (threadIdx.x == 0) *out.counters = c;
 }
 
 }  // namespace
@@ -170,22 +242,34 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs, int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream) {
-  launch(neighbor_pairs_kernel, neighbor_pair_count, stream, inputs, neighbor_pairs, neighbor_pair_count, results);
-  launch(traverse_kernel, tree.shape.leaf_count, stream, tree, inputs, results);
+  const int64_t traverse_blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
+  const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
+  if (blocks == 0) return;
+  narrow_phase_kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
+      tree, inputs, neighbor_pairs, neighbor_pair_count, static_cast<unsigned>(traverse_blocks), results);
+  SNAG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_expand(const uint64_t* hits, unsigned long long hit_count, const uint64_t* duplicates,
-                   unsigned long long duplicate_count, const int32_t* edge_face_offsets, const int32_t* edge_faces,
-                   const uint8_t* degenerate, int bits, uint64_t* keys, unsigned long long* fill, cudaStream_t stream) {
-  launch(expand_kernel, static_cast<int64_t>(hit_count + duplicate_count), stream, hits, hit_count, duplicates,
-         duplicate_count, edge_face_offsets, edge_faces, degenerate, bits, keys, fill);
+void launch_expand(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
+                   unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* edge_face_offsets,
+                   const int32_t* edge_faces, const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
+                   const geom::Tri* triangles, const PairSet& set, cudaStream_t stream) {
+  launch(expand_kernel, static_cast<int64_t>(hit_capacity + duplicate_capacity), stream, hits, hit_capacity,
+         duplicates, duplicate_capacity, counters, edge_face_offsets, edge_faces, degenerate, bits, positions,
+         triangles, set);
 }
 
-void launch_classify(const uint64_t* keys, const unsigned long long* count, unsigned long long capacity, int bits,
-                     uint64_t sentinel, const geom::Vec3d* positions, const geom::Tri* triangles, uint8_t* status,
-                     cudaStream_t stream) {
-  launch(classify_kernel, static_cast<int64_t>(capacity), stream, keys, count, capacity, bits, sentinel, positions,
-         triangles, status);
+void configure_kernels() {
+  SNAG_CUDA_CHECK(cudaFuncSetAttribute(finish_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                       static_cast<int>(kFinishShared)));
+}
+
+void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
+                   unsigned long long uncertain_capacity, int key_bits, int task_bits, const HostResults& out,
+                   cudaStream_t stream) {
+  finish_kernel<<<1, kFinishThreads, kFinishShared, stream>>>(counters, set, uncertain, uncertain_capacity, key_bits,
+                                                             task_bits, out);
+  SNAG_CUDA_CHECK_LAUNCH();
 }
 
 }  // namespace snag::cuda

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "cuda_check.cuh"
 #include "snag/bvh/tree.h"
 #include "snag/detect/pair_test.h"
 #include "snag/detect/topology.h"
@@ -25,7 +26,40 @@ struct FrameCounters {
   unsigned long long expanded;    ///< sum over hits of the edge's face count: a bound on pairs
   unsigned long long degenerate;  ///< scan: certainly degenerate triangles
   unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
+  unsigned long long pairs;       ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
 };
+
+/// The pairs of a frame as the expansion leaves them: distinct (a << bits | b) keys, a < b, in
+/// no particular order, each with its filtered kind (bit 0 = touching, bit 1 = certain), and
+/// the open-addressing set that made them distinct (empty slots hold kEmptyKey; cleared before
+/// every expansion). table_mask + 1 (a power of two) is at least twice pair_capacity, so a
+/// probe always ends.
+struct PairSet {
+  unsigned long long* table = nullptr;
+  unsigned long long table_mask = 0;
+  uint64_t* keys = nullptr;
+  uint8_t* status = nullptr;
+  unsigned long long pair_capacity = 0;
+};
+
+inline constexpr unsigned long long kEmptyKey = ~0ull;
+
+/// Where finish_kernel puts a frame's results: host memory mapped into the device's address
+/// space (written by the kernel, read by the host after the stream's sync), at most
+/// `limit` pairs and `limit` uncertain tests; counters always.
+struct HostResults {
+  uint64_t* keys = nullptr;
+  uint8_t* status = nullptr;
+  uint64_t* uncertain = nullptr;
+  FrameCounters* counters = nullptr;
+  unsigned long long limit = 0;
+};
+
+/// One block sorts at most this many pairs (and uncertain tests) in shared memory; frames with
+/// more go through CUB's device-wide sort after the host has read the counts.
+inline constexpr int kFinishThreads = 1024;
+inline constexpr int kFinishItems = 8;
+inline constexpr unsigned long long kFinishLimit = kFinishThreads * kFinishItems;
 
 /// Where the narrow phase appends its results. Hits and uncertain tests are (edge << 32 |
 /// triangle) keys, duplicated faces (a << 32 | b) keys with a < b.
@@ -45,6 +79,9 @@ struct PairInputs {
   const uint8_t* degenerate = nullptr;  ///< per triangle, 1 when left out this frame
 };
 
+/// Kernel attributes (finish_kernel's shared memory) on the current device: once per backend.
+void configure_kernels();
+
 /// Degenerate-triangle scan: appends ids the filter finds degenerate to `degenerate` and ids it
 /// cannot decide to `uncertain` (both in any order), counting them in counters.
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, int32_t* degenerate,
@@ -53,27 +90,33 @@ void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* trian
 /// Sets degenerate[list[i]] = 1.
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate, cudaStream_t stream);
 
-/// planes[t] = the plane of triangle t (detect::triangle_plane).
+/// planes[t] = the plane of triangle t (detect::triangle_plane). The refit computes them too; this
+/// is for frames whose tree was not refit to the current positions.
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, geom::PlaneCoefficients* planes,
                    cudaStream_t stream);
 
-/// The candidate pairs of the neighbour list, then those of the traversal (one thread per leaf
-/// position, in leaf order), each through detect::test_candidate_pair.
+/// The candidate pairs of the traversal (one thread per leaf position, in leaf order) and those
+/// of the neighbour list (one thread per pair), each through detect::test_candidate_pair: one
+/// launch, the traversal's blocks first (they run longest).
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs, int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
-/// triangle itself, and every duplicated face pair, as keys (a << bits | b) appended at
-/// *fill to `keys`; the rest of `keys` keeps what it held (the caller's sentinel).
-void launch_expand(const uint64_t* hits, unsigned long long hit_count, const uint64_t* duplicates,
-                   unsigned long long duplicate_count, const int32_t* edge_face_offsets, const int32_t* edge_faces,
-                   const uint8_t* degenerate, int bits, uint64_t* keys, unsigned long long* fill, cudaStream_t stream);
+/// triangle itself, and every duplicated face pair, made distinct in `set` and classified with
+/// the double filter (detect::is_crossing) once each. Reads the counts from `counters` (the
+/// narrow phase's), so it can be queued before they are known: the grid covers the buffers'
+/// capacities, and entries past a count or past a capacity are not read.
+void launch_expand(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
+                   unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* edge_face_offsets,
+                   const int32_t* edge_faces, const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
+                   const geom::Tri* triangles, const PairSet& set, cudaStream_t stream);
 
-/// For each of the first *count keys (sorted unique pairs; the sentinel skipped), the kind with
-/// the double filter: status[i] bit 0 = touching, bit 1 = certain.
-void launch_classify(const uint64_t* keys, const unsigned long long* count, unsigned long long capacity, int bits,
-                     uint64_t sentinel, const geom::Vec3d* positions, const geom::Tri* triangles, uint8_t* status,
-                     cudaStream_t stream);
+/// One block: when the frame's pairs and uncertain tests each fit in the block (and in
+/// out.limit), sorts them (pairs by key over key_bits, uncertain tests by (edge, triangle) over
+/// task_bits) and writes them to `out`; always copies the counters to out.counters.
+void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
+                   unsigned long long uncertain_capacity, int key_bits, int task_bits, const HostResults& out,
+                   cudaStream_t stream);
 
 }  // namespace snag::cuda

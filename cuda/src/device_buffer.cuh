@@ -78,6 +78,15 @@ class PinnedBuffer {
   size_t capacity_ = 0;
 };
 
+/// The device address of pinned host memory (every cudaMallocHost allocation is mapped under
+/// UVA): kernels write small results there directly, and the host reads them after the sync.
+template <class T>
+T* mapped(T* host) {
+  void* device = nullptr;
+  SNAG_CUDA_CHECK(cudaHostGetDevicePointer(&device, host, 0));
+  return static_cast<T*>(device);
+}
+
 /// A stream and a pair of events owned together.
 class Stream {
  public:
@@ -109,12 +118,19 @@ class EventTimer {
   EventTimer(const EventTimer&) = delete;
   EventTimer& operator=(const EventTimer&) = delete;
   void start(cudaStream_t stream) { SNAG_CUDA_CHECK(cudaEventRecord(start_, stream)); }
-  double stop(cudaStream_t stream) {
-    SNAG_CUDA_CHECK(cudaEventRecord(stop_, stream));
+  /// Records the stop without waiting for it (elapsed() waits).
+  void stop_async(cudaStream_t stream) { SNAG_CUDA_CHECK(cudaEventRecord(stop_, stream)); }
+  double elapsed() {
     SNAG_CUDA_CHECK(cudaEventSynchronize(stop_));
     float ms = 0;
     SNAG_CUDA_CHECK(cudaEventElapsedTime(&ms, start_, stop_));
     return ms;
+  }
+  cudaEvent_t start_event() const { return start_; }
+  cudaEvent_t stop_event() const { return stop_; }
+  double stop(cudaStream_t stream) {
+    stop_async(stream);
+    return elapsed();
   }
 
  private:

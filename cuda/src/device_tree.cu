@@ -7,6 +7,7 @@
 #include <cub/device/device_scan.cuh>
 
 #include "launch.cuh"
+#include "snag/detect/pair_test.h"
 
 namespace snag::cuda {
 
@@ -101,10 +102,21 @@ __global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_
   out[base + to] = t;
 }
 
-__global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh) {
+/// The leaf at position p fit to its triangle, whose plane the narrow phase reads (computed
+/// here, where the corners are loaded anyway, instead of in a launch of its own).
+__device__ __forceinline__ int32_t refit_leaf_and_plane(const bvh::TreeView& tree, const mesh::MeshView& mesh,
+                                                        geom::PlaneCoefficients* planes, int32_t p) {
+  const int32_t leaf = tree.shape.leaf_at(p);
+  bvh::refit_leaf(leaf, tree, mesh);
+  const int32_t t = tree.triangle_at[p];
+  planes[t] = detect::triangle_plane(mesh.positions, mesh.triangles[t]);
+  return leaf;
+}
+
+__global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes) {
   const int32_t n = tree.shape.leaf_count;
   const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (p < n) bvh::refit_leaf(tree.shape.leaf_at(p), tree, mesh);
+  if (p < n) refit_leaf_and_plane(tree, mesh, planes, p);
 }
 
 __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t last) {
@@ -117,12 +129,12 @@ __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t la
 /// sibling's box complete: the sibling's writer made its box visible (__threadfence) before
 /// its atomicAdd, and the box is read from L2 (__ldcg), past a possibly stale L1 line. The
 /// second arrival resets the counter, so every counter is zero again after the launch.
-__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, uint32_t* counters) {
+__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
+                                   uint32_t* counters) {
   const int32_t n = tree.shape.leaf_count;
   const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (p >= n) return;
-  int32_t node = tree.shape.leaf_at(p);
-  bvh::refit_leaf(node, tree, mesh);
+  int32_t node = refit_leaf_and_plane(tree, mesh, planes, p);
   while (node > 0) {
     const int32_t parent = (node - 1) >> 1;
     __threadfence();
@@ -139,18 +151,16 @@ __global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, uint
   }
 }
 
-/// The quality's block sums, one thread per block of bvh::kQualityBlock internal nodes, each
-/// in the order the CPU adds them (bvh::quality_block_sum).
-__global__ void quality_blocks_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape, int32_t blocks,
-                                      double* block_sums) {
-  const int32_t block = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (block < blocks) block_sums[block] = bvh::quality_block_sum(boxes, shape, block);
-}
-
-/// The block sums in order (bvh::quality_from_blocks): a few dozen additions for 36K triangles.
-__global__ void quality_finish_kernel(const double* block_sums, int32_t blocks, const geom::Box3f* boxes,
-                                      double* out) {
-  *out = bvh::quality_from_blocks(block_sums, blocks, boxes[0]);
+/// The quality in one launch of one block: thread b sums block b of bvh::kQualityBlock internal
+/// nodes in the CPU's order (bvh::quality_block_sum), then thread 0 adds the block sums in
+/// order (bvh::quality_from_blocks). The sums must be sequential to match the CPU bit for bit,
+/// so the floor is one block's 1024 dependent additions; the blocks run side by side.
+__global__ void quality_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape, int32_t blocks, double* block_sums,
+                               double* out) {
+  for (int32_t block = static_cast<int32_t>(threadIdx.x); block < blocks; block += static_cast<int32_t>(blockDim.x))
+    block_sums[block] = bvh::quality_block_sum(boxes, shape, block);
+  __syncthreads();  // every block sum written (global memory, one block: the barrier orders it)
+  if (threadIdx.x == 0) *out = bvh::quality_from_blocks(block_sums, blocks, boxes[0]);
 }
 
 }  // namespace
@@ -171,7 +181,6 @@ void DeviceTree::resize(int32_t n) {
   keys_.reserve(3 * count);
   keys_alt_.reserve(3 * count);
   ids_.reserve(3 * count);
-  quality_.reserve(1);
   quality_host_.reserve(1);
   quality_blocks_.reserve(static_cast<size_t>((n + bvh::kQualityBlock - 1) / bvh::kQualityBlock));
   // Scratch for the sorts and the scans, sized for the largest of them.
@@ -184,7 +193,7 @@ void DeviceTree::resize(int32_t n) {
   capacity_ = n;
 }
 
-void DeviceTree::build(mesh::MeshView mesh, cudaStream_t stream) {
+void DeviceTree::build(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cudaStream_t stream) {
   const int32_t n = mesh.triangle_count;
   resize(n);
   if (n == 0) return;
@@ -209,18 +218,18 @@ void DeviceTree::build(mesh::MeshView mesh, cudaStream_t stream) {
   // Every list holds the leaf order now; the first one becomes the permutation.
   SNAG_CUDA_CHECK(cudaMemcpyAsync(triangle_at_.data(), lists_.data(), count * sizeof(int32_t),
                                   cudaMemcpyDeviceToDevice, stream));
-  refit(mesh, stream);
+  refit(mesh, planes, stream);
 }
 
-void DeviceTree::refit(mesh::MeshView mesh, cudaStream_t stream) {
+void DeviceTree::refit(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cudaStream_t stream) {
   const int32_t n = shape_.leaf_count;
   if (n == 0) return;
   const bvh::TreeView tree = view();
   if (!level_by_level_refit) {
-    launch(refit_climb_kernel, n, stream, tree, mesh, refit_counters_.data());
+    launch(refit_climb_kernel, n, stream, tree, mesh, planes, refit_counters_.data());
     return;
   }
-  launch(refit_leaves_kernel, n, stream, tree, mesh);
+  launch(refit_leaves_kernel, n, stream, tree, mesh, planes);
   for (int32_t level = shape_.depth - 1; level >= 0; --level) {
     const int32_t first = CompleteTree::level_begin(level);
     const int32_t last = std::min(CompleteTree::level_begin(level + 1), n - 1);
@@ -228,16 +237,22 @@ void DeviceTree::refit(mesh::MeshView mesh, cudaStream_t stream) {
   }
 }
 
-double DeviceTree::quality(cudaStream_t stream) {
+void DeviceTree::queue_quality(cudaStream_t stream) {
   const int32_t blocks = bvh::quality_block_count(shape_);
-  if (blocks == 0) return 0.0;
-  launch(quality_blocks_kernel, blocks, stream, boxes_.data(), shape_, blocks, quality_blocks_.data());
-  quality_finish_kernel<<<1, 1, 0, stream>>>(quality_blocks_.data(), blocks, boxes_.data(), quality_.data());
+  if (blocks == 0) {
+    *quality_host_.data() = 0.0;
+    return;
+  }
+  const int threads = std::min(blocks, 1024);
+  quality_kernel<<<1, ((threads + 31) / 32) * 32, 0, stream>>>(boxes_.data(), shape_, blocks, quality_blocks_.data(),
+                                                               mapped(quality_host_.data()));
   SNAG_CUDA_CHECK_LAUNCH();
-  SNAG_CUDA_CHECK(cudaMemcpyAsync(quality_host_.data(), quality_.data(), sizeof(double), cudaMemcpyDeviceToHost,
-                                  stream));
+}
+
+double DeviceTree::quality(cudaStream_t stream) {
+  queue_quality(stream);
   SNAG_CUDA_CHECK(cudaStreamSynchronize(stream));
-  return *quality_host_.data();
+  return queued_quality();
 }
 
 }  // namespace snag::cuda

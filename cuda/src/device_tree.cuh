@@ -14,6 +14,7 @@
 
 #include "device_buffer.cuh"
 #include "snag/bvh/tree.h"
+#include "snag/geom/predicates.h"
 #include "snag/geom/vec3.h"
 #include "snag/mesh/mesh.h"
 
@@ -36,14 +37,20 @@ class DeviceTree {
   /// partition keeps each list sorted within the two halves, so the invariant holds for the
   /// next level, and each half gets exactly the set nth_element gives the CPU: the tree depends
   /// only on those sets, so it is the CPU's tree. O(n) work per level, four launches.
-  void build(mesh::MeshView mesh, cudaStream_t stream);
+  void build(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cudaStream_t stream);
 
-  /// Recomputes every box from `mesh`'s positions. Asynchronous.
-  void refit(mesh::MeshView mesh, cudaStream_t stream);
+  /// Recomputes every box from `mesh`'s positions, and planes[t] = detect::triangle_plane of
+  /// every triangle t (the narrow phase's, computed where the corners are loaded anyway).
+  /// Asynchronous.
+  void refit(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cudaStream_t stream);
 
   /// Sum of internal-node half areas over the root's (0 for a single leaf), in the blocked
   /// order of bvh::quality_block_sum, so that it is the CPU's bit for bit. Waits for the stream.
   double quality(cudaStream_t stream);
+  /// Queues the quality (one launch) into pinned host memory; queued_quality() reads it once
+  /// the stream has passed it.
+  void queue_quality(cudaStream_t stream);
+  double queued_quality() const { return *quality_host_.data(); }
 
   bool level_by_level_refit = false;
 
@@ -63,7 +70,6 @@ class DeviceTree {
   DeviceBuffer<uint64_t> keys_, keys_alt_;
   DeviceBuffer<int32_t> ids_;
   DeviceBuffer<unsigned char> temp_;
-  DeviceBuffer<double> quality_;
   DeviceBuffer<double> quality_blocks_;  // one sum per bvh::kQualityBlock internal nodes
   PinnedBuffer<double> quality_host_;
   int32_t capacity_ = 0;

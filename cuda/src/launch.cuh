@@ -11,6 +11,10 @@
 namespace snag::cuda {
 
 inline constexpr int kBlock = 256;
+/// The narrow phase's blocks: 36K triangles are only ~270 traversal threads per SM of an H100,
+/// so blocks of 64 spread them evenly (blocks of 256 left a few SMs with two blocks, the rest
+/// with one, and the frame waited for the doubled ones).
+inline constexpr int kNarrowBlock = 64;
 
 template <class... Params, class... Args>
 void launch(void (*kernel)(Params...), int64_t count, cudaStream_t stream, Args&&... args) {

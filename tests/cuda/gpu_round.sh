@@ -10,21 +10,30 @@ export SNAG_DATA_DIR=${SNAG_DATA_DIR:-$PWD/.gpu/extra/data}
 steps=("$@"); [ ${#steps[@]} -gt 0 ] || steps=(tests sanitize reports bench)
 summary=()
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+tests_rc=0
 for step in "${steps[@]}"; do
   t0=$(date +%s)
+  # A failing test suite makes the later steps moot: stop there (device time is scarce).
+  [ $tests_rc -eq 0 ] || { summary+=("$step             skipped: the CUDA tests failed"); continue; }
   case $step in
     tests)
       snag_cuda_tests --gtest_brief=1 >"$out/cuda_tests.log" 2>&1; rc=$?
       summary+=("cuda tests        rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cuda_tests.log" | tr '\n' ' ')")
+      tests_rc=$rc
       grep -E '^\[  FAILED  \]' "$out/cuda_tests.log" | head -20
       SNAG_EXECUTABLE=$(command -v snag) snag_cli_tests --gtest_brief=1 >"$out/cli_tests.log" 2>&1; rc=$?
       summary+=("cli tests         rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cli_tests.log" | tr '\n' ' ')")
       ;;
     sanitize)
-      filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
+      # memcheck: every test but the two largest; racecheck (much slower): small tests that still
+      # run every kernel (build, both refits, quality, scan, narrow phase, expansion, the
+      # one-block finish, the growth and the device-wide sorts of the large path).
+      memcheck_filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
+      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.LatticeSoups*:CudaDetect.MoreResults*:CudaDetect.DegenerateFaces*:CudaBackend.*'
       for tool in memcheck racecheck; do
-        compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 --gtest_filter="$filter" \
-          >"$out/sanitize_$tool.log" 2>&1; rc=$?
+        filter=$memcheck_filter; [ $tool = racecheck ] && filter=$racecheck_filter
+        timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
+          --gtest_filter="$filter" >"$out/sanitize_$tool.log" 2>&1; rc=$?
         summary+=("$tool         rc=$rc $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitize_$tool.log" | tail -1) $(grep -E '^\[  (PASSED|FAILED) ' "$out/sanitize_$tool.log" | tr '\n' ' ')")
       done
       ;;

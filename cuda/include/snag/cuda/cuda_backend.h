@@ -22,16 +22,19 @@ namespace snag::cuda {
 int cuda_device_count();
 
 /// Device-side time of the last run of each stage, in milliseconds, from CUDA events recorded
-/// on the backend's stream around the stage's kernels and copies (host gaps inside a stage,
-/// such as waiting for a count, are included).
+/// on the backend's stream around the stage's kernels and copies. Stages are queued without
+/// waiting where the interface allows: a checker's frame waits twice, at the end of the scan
+/// and at the end of detect().
 struct StageTimes {
   double upload = 0;    ///< positions: pinned host buffer to device
-  double scan = 0;      ///< degenerate-triangle scan, with its result back on the host
-  double build = 0;     ///< the whole GPU build, boxes included
-  double refit = 0;     ///< boxes from the current positions
-  double quality = 0;   ///< tree quality, back on the host
-  double traverse = 0;  ///< traversal with the filtered narrow phase, counts back on the host
-  double classify = 0;  ///< hits expanded to pairs, sorted, unique, classified, copied back
+  double scan = 0;      ///< degenerate-triangle scan with its result on the host; in a checker's
+                        ///< frame also the refit and the quality queued ahead of their calls
+  double build = 0;     ///< the whole GPU build, boxes and planes included
+  double refit = 0;     ///< boxes and planes from the current positions (0 when refit() found
+                        ///< the tree already fit to them, refit ahead in the scan or built)
+  double quality = 0;   ///< tree quality, back on the host (not updated when it was ready)
+  double traverse = 0;  ///< the traversal and the neighbour pass with the filtered narrow phase
+  double classify = 0;  ///< hits expanded into distinct classified pairs, sorted, on the host
 };
 
 /// The CUDA backend with what the benchmark and the tests need beyond detect::Backend.
@@ -45,8 +48,10 @@ class CudaBackend : public detect::Backend {
   /// Makes resident frame `index` the current positions (no copy).
   virtual void select_resident_frame(int index) = 0;
   /// The initial capacity, in entries, of each result buffer (hits, uncertain tests, duplicated
-  /// faces). A frame that finds more grows the buffers to what it found and traverses again, so
-  /// this changes speed, never results; tests set it small to exercise the growth.
+  /// faces, pairs). A frame that finds more grows the buffers to what it found and traverses
+  /// again, so this changes speed, never results; tests set it small to exercise the growth.
+  /// It also caps the pairs and uncertain tests sorted by one block (at most 8192) before the
+  /// device-wide sorts take over, so small values exercise that path too.
   virtual void set_result_capacity(int64_t entries) = 0;
   /// Refit strategy: one launch in which each leaf's thread climbs while it is the second child
   /// to arrive (an atomic counter per node; the default), or one launch per level.
