@@ -93,7 +93,8 @@ class CpuBackend final : public Backend {
         const auto [t, x] = topo.neighbor_pairs[i];
         if (degenerate_flags[t] || degenerate_flags[x]) continue;
         ++sink.candidates;
-        test_candidate_pair(frame_view, view, t, x, sink);
+        const uint32_t shared = topo.neighbor_shared[i];
+        test_pair_given_shared(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
       }
       // The other candidates from the traversal: the leaves of each group of up to four
       // consecutive positions walk the tree together (for_each_later_overlap_grouped), groups

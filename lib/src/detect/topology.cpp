@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "snag/detect/pair_test.h"
 #include "snag/error.h"
 
 namespace snag::detect {
@@ -46,6 +47,12 @@ void make_neighbor_pairs(Topology& topo) {
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  topo.neighbor_shared.resize(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    uint32_t a_shared, b_shared;
+    shared_corners(topo.triangles[pairs[i][0]], topo.triangles[pairs[i][1]], a_shared, b_shared);
+    topo.neighbor_shared[i] = static_cast<uint8_t>(a_shared | b_shared << 3);
+  }
 }
 
 }  // namespace

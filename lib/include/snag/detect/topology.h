@@ -35,6 +35,9 @@ struct Topology {
   /// listed when at most kMaxListedValence triangles use it, which bounds the list by
   /// kMaxListedValence^2 / 2 pairs per vertex; pairs around larger fans stay with the traversal.
   std::vector<std::array<int32_t, 2>> neighbor_pairs;
+  /// Per neighbour pair (a, b): bits 0-2 mark the corners of a that are vertices of b, bits
+  /// 3-5 the corners of b that are vertices of a (shared_corners, fixed with the topology).
+  std::vector<uint8_t> neighbor_shared;
   std::vector<uint8_t> listed_vertex;  ///< per vertex: 1 when its fan's pairs are listed
   bool every_vertex_listed = true;
   static constexpr int32_t kMaxListedValence = 32;
