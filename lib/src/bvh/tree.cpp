@@ -7,6 +7,10 @@ namespace snag::bvh {
 
 namespace {
 
+/// Levels with fewer nodes than this are refit on one thread: splitting them costs more than
+/// it saves.
+constexpr int32_t kParallelLevel = 4096;
+
 /// The internal nodes of `level`: [first, last).
 void internal_nodes_of_level(const CompleteTree& shape, int32_t level, int32_t& first, int32_t& last) {
   first = CompleteTree::level_begin(level);
@@ -57,24 +61,31 @@ void Tree::build(mesh::MeshView mesh, int threads) {
       });
     }
   }
+  leaf_of_triangle_.resize(static_cast<size_t>(n));
+  for (int32_t p = 0; p < n; ++p) leaf_of_triangle_[triangle_at_[p]] = shape_.leaf_at(p);
   refit(mesh, threads);
 }
 
 void Tree::refit(mesh::MeshView mesh, int threads) {
   TreeView tree = view();
   const int32_t n = shape_.leaf_count;
-#pragma omp parallel num_threads(threads)
-  {
-#pragma omp for schedule(static)
-    for (int32_t leaf = n - 1; leaf < 2 * n - 1; ++leaf) refit_leaf(leaf, tree, mesh);
-    // One level at a time from the deepest internal level up; the implicit barrier after
-    // each loop orders a level's writes before its parents read them.
-    for (int32_t level = shape_.depth - 1; level >= 0; --level) {
-      int32_t first, last;
-      internal_nodes_of_level(shape_, level, first, last);
-#pragma omp for schedule(static)
-      for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
-    }
+  // Leaves in triangle order: the corners are read in file order (mostly sequential) and
+  // only the box writes scatter, where leaf order would scatter every read.
+#pragma omp parallel for num_threads(threads) schedule(static) if (n > kParallelLevel)
+  for (int32_t t = 0; t < n; ++t) {
+    const geom::Tri tri = mesh.triangles[t];
+    tree.boxes[leaf_of_triangle_[t]] =
+        geom::triangle_box(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
+  }
+  // One level at a time from the deepest internal level up, each level in parallel; the end
+  // of each loop orders a level's writes before its parents read them. Levels too small to
+  // gain from threads run on one, without a barrier: barriers are what costs when the machine
+  // is shared and threads get descheduled.
+  for (int32_t level = shape_.depth - 1; level >= 0; --level) {
+    int32_t first, last;
+    internal_nodes_of_level(shape_, level, first, last);
+#pragma omp parallel for num_threads(threads) schedule(static) if (last - first > kParallelLevel)
+    for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
   }
 }
 

@@ -1,6 +1,7 @@
 // The BVH over one mesh: boxes of the complete tree (complete_tree.h) and the permutation from
 // leaf positions to triangles. Memory: 24 bytes per node (a float box, rounded outward) for
-// 2n - 1 nodes, plus 4 bytes per triangle for the permutation: about 52 bytes per triangle.
+// 2n - 1 nodes, plus 4 bytes per triangle for the permutation (and, on the host, 4 for its
+// inverse): about 52 (56) bytes per triangle.
 #pragma once
 
 #include <cstdint>
@@ -178,6 +179,8 @@ class Tree {
   double quality() const;
 
   TreeView view() { return {shape_, boxes_.data(), triangle_at_.data()}; }
+  /// The inverse of triangle_at: the leaf node of each triangle.
+  const std::vector<int32_t>& leaf_of_triangle() const { return leaf_of_triangle_; }
   const CompleteTree& shape() const { return shape_; }
   const std::vector<geom::Box3f>& boxes() const { return boxes_; }
   const std::vector<int32_t>& triangle_at() const { return triangle_at_; }
@@ -186,6 +189,7 @@ class Tree {
   CompleteTree shape_;
   std::vector<geom::Box3f> boxes_;
   std::vector<int32_t> triangle_at_;
+  std::vector<int32_t> leaf_of_triangle_;
 };
 
 }  // namespace snag::bvh
