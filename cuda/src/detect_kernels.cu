@@ -188,7 +188,7 @@ __global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCount
   extern __shared__ __align__(16) unsigned char shared[];
   const FrameCounters c = *counters;
   const unsigned long long limit = min(out.limit, kFinishLimit);
-  if (c.pairs <= limit && c.pairs <= set.pair_capacity) {
+  if (c.pairs > 0 && c.pairs <= limit && c.pairs <= set.pair_capacity) {
     uint64_t keys[kFinishItems];
     uint8_t status[kFinishItems];
     for (int k = 0; k < kFinishItems; ++k) {
@@ -207,7 +207,7 @@ __global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCount
     }
     __syncthreads();  // the shared memory is the next sort's
   }
-  if (c.uncertain <= limit && c.uncertain <= uncertain_capacity) {
+  if (c.uncertain > 0 && c.uncertain <= limit && c.uncertain <= uncertain_capacity) {
     uint64_t keys[kFinishItems];
     for (int k = 0; k < kFinishItems; ++k) {
       const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kFinishItems + k;

@@ -25,11 +25,12 @@ for step in "${steps[@]}"; do
       summary+=("cli tests         rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cli_tests.log" | tr '\n' ' ')")
       ;;
     sanitize)
-      # memcheck: every test but the two largest; racecheck (much slower): small tests that still
-      # run every kernel (build, both refits, quality, scan, narrow phase, expansion, the
-      # one-block finish, the growth and the device-wide sorts of the large path).
+      # memcheck: every test but the two largest; racecheck (much slower, and only shared
+      # memory is its business): small tests that still run every kernel (build, refit,
+      # quality, scan, narrow phase, expansion, the one-block finish, the growth and the
+      # device-wide sorts of the large path).
       memcheck_filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
-      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.LatticeSoups*:CudaDetect.MoreResults*:CudaDetect.DegenerateFaces*:CudaBackend.*'
+      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*'
       for tool in memcheck racecheck; do
         filter=$memcheck_filter; [ $tool = racecheck ] && filter=$racecheck_filter
         timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
