@@ -86,6 +86,7 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.edge_faces, topology.edge_faces.data(), topology.edge_faces.size(), s);
     upload(d.listed_vertex, topology.listed_vertex.data(), topology.listed_vertex.size(), s);
     upload(d.neighbor_pairs, topology.neighbor_pairs.data(), topology.neighbor_pairs.size(), s);
+    upload(d.neighbor_shared, topology.neighbor_shared.data(), topology.neighbor_shared.size(), s);
     d.frame_owned_edges.reserve(std::max<size_t>(n, 1));
     d.degenerate.reserve(std::max<size_t>(n, 1));
     d.degenerate_list.reserve(std::max<size_t>(n, 1));
@@ -400,7 +401,8 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     out.limit = finish_limit_;
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
     SNAG_CUDA_CHECK(cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
-    launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(), topo_.neighbor_pair_count, results, s);
+    launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(), topo_.neighbor_shared.data(),
+                        topo_.neighbor_pair_count, results, s);
     narrow_timer_.stop_async(s);
     launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(), counters_.data(),
                   topo_.edge_face_offsets.data(), topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_,

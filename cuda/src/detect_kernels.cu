@@ -80,12 +80,14 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
 }
 
 /// One thread's share of the neighbour pass: listed pair i (their boxes always overlap).
-__device__ __forceinline__ void neighbor_pair(const PairInputs& in, const std::array<int32_t, 2>* pairs, int64_t i,
-                                              DeviceSink& sink, unsigned long long& candidates) {
+__device__ __forceinline__ void neighbor_pair(const PairInputs& in, const std::array<int32_t, 2>* pairs,
+                                              const uint8_t* shared_masks, int64_t i, DeviceSink& sink,
+                                              unsigned long long& candidates) {
   const int32_t t = pairs[i][0], x = pairs[i][1];
   if (in.degenerate[t] || in.degenerate[x]) return;
   ++candidates;
-  detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
+  const uint32_t shared = shared_masks[i];
+  detect::test_pair_given_shared(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
 }
 
 /// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
@@ -109,7 +111,8 @@ __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const P
 /// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
 __global__ void __launch_bounds__(kNarrowBlock) narrow_phase_kernel(bvh::TreeView tree, PairInputs in,
                                                                     const std::array<int32_t, 2>* pairs,
-                                                                    int64_t pair_count, unsigned traverse_blocks,
+                                                                    const uint8_t* shared_masks, int64_t pair_count,
+                                                                    unsigned traverse_blocks,
                                                                     ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
@@ -118,7 +121,7 @@ __global__ void __launch_bounds__(kNarrowBlock) narrow_phase_kernel(bvh::TreeVie
     if (position < tree.shape.leaf_count) traverse_leaf(tree, in, position, sink, candidates);
   } else {
     const int64_t i = static_cast<int64_t>(blockIdx.x - traverse_blocks) * blockDim.x + threadIdx.x;
-    if (i < pair_count) neighbor_pair(in, pairs, i, sink, candidates);
+    if (i < pair_count) neighbor_pair(in, pairs, shared_masks, i, sink, candidates);
   }
   add_warp_total(candidates, &out.counters->candidates);
   add_warp_total(sink.misses, &out.counters->misses);
@@ -240,13 +243,15 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 }
 
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs, int64_t neighbor_pair_count,
+                         const std::array<int32_t, 2>* neighbor_pairs, const uint8_t* neighbor_shared,
+                         int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream) {
   const int64_t traverse_blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
   const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
   if (blocks == 0) return;
   narrow_phase_kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
-      tree, inputs, neighbor_pairs, neighbor_pair_count, static_cast<unsigned>(traverse_blocks), results);
+      tree, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count, static_cast<unsigned>(traverse_blocks),
+      results);
   SNAG_CUDA_CHECK_LAUNCH();
 }
 

@@ -99,7 +99,8 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// of the neighbour list (one thread per pair), each through detect::test_candidate_pair: one
 /// launch, the traversal's blocks first (they run longest).
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs, int64_t neighbor_pair_count,
+                         const std::array<int32_t, 2>* neighbor_pairs, const uint8_t* neighbor_shared,
+                         int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the

@@ -26,6 +26,7 @@ struct DeviceTopology {
   DeviceBuffer<int32_t> edge_faces;
   DeviceBuffer<uint8_t> listed_vertex;
   DeviceBuffer<std::array<int32_t, 2>> neighbor_pairs;
+  DeviceBuffer<uint8_t> neighbor_shared;  ///< per neighbour pair: its shared-corner masks
   DeviceBuffer<int32_t> degenerate_list;  ///< upload area for a frame's degenerate ids
   int32_t triangle_count = 0;
   int32_t vertex_count = 0;
