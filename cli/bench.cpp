@@ -33,19 +33,14 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-struct Case {
-  std::string name;
-  std::vector<fs::path> files;
-};
-
 struct Row {
   std::string name;
   int triangles = 0;
   int frames = 0;
   int timed = 0;
   double build = 0, refit = 0, traverse = 0, exact = 0, total = 0, cgal = 0;
-  double read = 0;            ///< seconds to read one frame (median), one thread
-  double read_bytes = 0;      ///< bytes per frame file (median)
+  double read = 0;        ///< seconds to read one frame (median), one thread
+  double read_bytes = 0;  ///< bytes per frame file (median)
   int64_t pairs = 0;
   bool same = true;
   std::string note;
@@ -58,25 +53,10 @@ std::vector<std::pair<int32_t, int32_t>> pair_ids(const detect::FrameResult& r) 
   return ids;
 }
 
-Row run_case(const Case& c, const BenchOptions& o) {
-  std::cerr << "snag bench: " << c.name << ": reading " << c.files.size() << " frames\n";
-  std::vector<mesh::Mesh> meshes;
-  std::vector<double> read_seconds, read_bytes;
-  for (const fs::path& f : c.files) {
-    // Read twice, timing the second: the first brings the file into the page cache, so this
-    // times snag's reader, not the disk.
-    io::read_mesh(f);
-    const auto started = Clock::now();
-    meshes.push_back(io::read_mesh(f));
-    read_seconds.push_back(std::chrono::duration<double>(Clock::now() - started).count());
-    read_bytes.push_back(static_cast<double>(fs::file_size(f)));
-  }
-  if (meshes.empty()) throw InputError(c.name, 0, "no frames");
+Row run_case(const BenchCase& c, const BenchOptions& o) {
+  const CaseFrames read = read_case(c, "snag bench");
+  const std::vector<mesh::Mesh>& meshes = read.meshes;
   const mesh::Mesh& first = meshes.front();
-  for (const mesh::Mesh& m : meshes)
-    if (m.positions.size() != first.positions.size() ||
-        m.triangles.size() != first.triangles.size())
-      throw InputError(c.name, 0, "frames of a benchmark case must share one topology");
   const int32_t vertices = static_cast<int32_t>(first.positions.size());
 
   Row row;
@@ -129,8 +109,8 @@ Row run_case(const Case& c, const BenchOptions& o) {
   row.exact = median(exact);
   row.total = median(total);
   row.cgal = median(cgal);
-  row.read = median(read_seconds);
-  row.read_bytes = median(read_bytes);
+  row.read = median(read.read_seconds);
+  row.read_bytes = median(read.read_bytes);
   return row;
 }
 
@@ -138,17 +118,21 @@ void print_table(const std::vector<Row>& rows, int threads) {
   std::printf("snag bench cpu: %d threads; medians over the timed frames, milliseconds per frame\n",
               threads);
   std::printf(
-      "snag total = refit + traverse + exact/classify (the tree is built once per topology; build is\n"
-      "the time of one rebuild); CGAL = self_intersections on its halfedge mesh built once, positions\n"
-      "updated per frame, sequential; read = snag reading one frame file from the page cache, one thread\n\n");
-  std::printf("%-22s %9s %6s %8s %8s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "case", "triangles", "frames",
-              "read", "MB/s", "build", "refit", "traverse", "exact", "total", "CGAL", "CGAL/snag", "pairs", "same");
+      "snag total = refit + traverse + exact/classify (the tree is built once per topology; build "
+      "is\n"
+      "the time of one rebuild); CGAL = self_intersections on its halfedge mesh built once, "
+      "positions\n"
+      "updated per frame, sequential; read = snag reading one frame file from the page cache, one "
+      "thread\n\n");
+  std::printf("%-22s %9s %6s %8s %8s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "case", "triangles",
+              "frames", "read", "MB/s", "build", "refit", "traverse", "exact", "total", "CGAL",
+              "CGAL/snag", "pairs", "same");
   for (const Row& r : rows) {
     const double ratio = r.total > 0 ? r.cgal / r.total : 0;
     const double rate = r.read > 0 ? r.read_bytes / r.read / 1e6 : 0;
     std::printf("%-22s %9d %6d %8.3f %8.0f %8.3f %8.3f %8.3f %8.3f %8.3f %9.3f %8.1fx %8lld %5s\n",
-                r.name.c_str(), r.triangles, r.timed, r.read * 1e3, rate, r.build * 1e3, r.refit * 1e3,
-                r.traverse * 1e3, r.exact * 1e3, r.total * 1e3, r.cgal * 1e3, ratio,
+                r.name.c_str(), r.triangles, r.timed, r.read * 1e3, rate, r.build * 1e3,
+                r.refit * 1e3, r.traverse * 1e3, r.exact * 1e3, r.total * 1e3, r.cgal * 1e3, ratio,
                 static_cast<long long>(r.pairs), r.same ? "yes" : "NO");
     if (!r.note.empty()) std::printf("  %s\n", r.note.c_str());
   }
@@ -194,38 +178,24 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
 
 int run_bench_cpu(const BenchOptions& o) {
   ScratchDir scratch;
-  std::vector<Case> cases;
-
-  const fs::path data = data_folder(o.data_dir);
-  const fs::path ball = data / "scalable-ccd" / "cloth-ball";
-  if (!data.empty() && fs::is_directory(ball)) {
-    Case c{"cloth-ball", {}};
-    for (const seq::Frame& f : seq::resolve_sequence(ball.string())) c.files.push_back(f.path);
-    cases.push_back(std::move(c));
-  } else if (!o.data_dir.empty()) {
-    throw UsageError("--data " + o.data_dir + ": no scalable-ccd/cloth-ball folder in it");
-  } else {
-    std::cerr << "snag bench: no shared data folder (" << ball.string()
-              << "); the cloth-ball case is left out\n";
-  }
-
-  for (const std::string& input : o.inputs) {
-    Case c{fs::path(input).filename().string(), {}};
-    for (const seq::Frame& f : seq::resolve_sequence(input)) c.files.push_back(f.path);
-    cases.push_back(std::move(c));
-  }
+  std::vector<BenchCase> cases;
+  add_data_case(cases, data_folder(o.data_dir), o.data_dir, "cloth-ball", "scalable-ccd/cloth-ball",
+                "snag bench");
+  for (const std::string& input : o.inputs)
+    cases.push_back(sequence_case(fs::path(input).filename().string(), input));
   // Generated cases last to be made (after the arguments were checked), first in the table.
-  std::vector<Case> generated;
+  std::vector<BenchCase> generated;
   for (int size : o.sizes) {
     if (size <= 0) continue;
     const fs::path dir = scratch.path() / std::to_string(size);
-    generated.push_back({"cloth " + std::to_string(size), generated_cloth(o.generator, size, settle_frames, o.frames, dir)});
+    generated.push_back({"cloth " + std::to_string(size),
+                         generated_cloth(o.generator, size, settle_frames, o.frames, dir)});
   }
   cases.insert(cases.begin(), generated.begin(), generated.end());
   if (cases.empty()) throw UsageError("nothing to time: no --sizes, no data folder, no --input");
 
   std::vector<Row> rows;
-  for (const Case& c : cases) rows.push_back(run_case(c, o));
+  for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
   print_table(rows, o.threads > 0 ? o.threads : omp_get_max_threads());
   const bool all_same = std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; });
   if (!all_same) throw InternalError("snag and CGAL found different pairs (see the table)");

@@ -29,9 +29,11 @@
 namespace snag::cli {
 
 CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
-  CLI::App* gpu = bench.add_subcommand(
-      "gpu", "Time the CUDA backend's stages with CUDA events, next to the CPU backend and the paper's table");
-  gpu->add_option("--sizes", o.sizes, "Generated cloth sizes in triangles (0 or an empty list: none)")
+  CLI::App* gpu = bench.add_subcommand("gpu",
+                                       "Time the CUDA backend's stages with CUDA events, next to "
+                                       "the CPU backend and the paper's table");
+  gpu->add_option("--sizes", o.sizes,
+                  "Generated cloth sizes in triangles (0 or an empty list: none)")
       ->type_name("T,...")
       ->delimiter(',')
       ->check(CLI::NonNegativeNumber)
@@ -57,9 +59,11 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
                   "The shared data folder; its cloth-ball and n-body frames are cases when present "
                   "(default: $SNAG_DATA_DIR, else the one known at build time)")
       ->type_name("DIR");
-  gpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")->type_name("SEQUENCE");
-  gpu->add_option("--generator", o.generator,
-                  "The snag-cloth sample generator (default: beside snag, in the build tree, or on PATH)")
+  gpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")
+      ->type_name("SEQUENCE");
+  gpu->add_option(
+         "--generator", o.generator,
+         "The snag-cloth sample generator (default: beside snag, in the build tree, or on PATH)")
       ->type_name("PATH");
   gpu->add_option("-j,--threads", o.threads, "CPU worker threads; 0 uses every core")
       ->type_name("N")
@@ -75,8 +79,9 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
 #ifndef SNAG_HAVE_CUDA
 
 int run_bench_gpu(const BenchGpuOptions&) {
-  throw DeviceUnavailable("bench gpu: this snag was built without the CUDA backend (no CUDA compiler was found "
-                          "when it was built)");
+  throw DeviceUnavailable(
+      "bench gpu: this snag was built without the CUDA backend (no CUDA compiler was found "
+      "when it was built)");
 }
 
 #else
@@ -86,19 +91,14 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-struct Case {
-  std::string name;
-  std::vector<fs::path> files;
-};
-
 /// Milliseconds, medians over the timed frames.
 struct Row {
   std::string name;
   int triangles = 0;
   int files = 0;
   int timed = 0;
-  double build = 0, refit = 0, quality = 0, scan = 0, traverse = 0, classify = 0, frame = 0, frame_host = 0,
-         upload = 0;
+  double build = 0, refit = 0, quality = 0, scan = 0, traverse = 0, classify = 0, frame = 0,
+         frame_host = 0, upload = 0;
   double cpu_build = 0, cpu_frame = 0;
   int64_t pairs = 0, candidates = 0;
   bool same = true;
@@ -111,11 +111,13 @@ double ms_since(Clock::time_point start) {
 
 /// The differences between two filtered frames, empty when they are the same.
 std::string difference(const detect::FilteredFrame& cpu, const detect::FilteredFrame& gpu) {
-  if (cpu.pairs != gpu.pairs) return "pairs differ (" + std::to_string(cpu.pairs.size()) + " cpu, " +
-                                     std::to_string(gpu.pairs.size()) + " gpu)";
+  if (cpu.pairs != gpu.pairs)
+    return "pairs differ (" + std::to_string(cpu.pairs.size()) + " cpu, " +
+           std::to_string(gpu.pairs.size()) + " gpu)";
   if (cpu.kind_certain != gpu.kind_certain) return "certain kinds differ";
-  if (cpu.uncertain != gpu.uncertain) return "uncertain tests differ (" + std::to_string(cpu.uncertain.size()) +
-                                             " cpu, " + std::to_string(gpu.uncertain.size()) + " gpu)";
+  if (cpu.uncertain != gpu.uncertain)
+    return "uncertain tests differ (" + std::to_string(cpu.uncertain.size()) + " cpu, " +
+           std::to_string(gpu.uncertain.size()) + " gpu)";
   if (cpu.candidate_pairs != gpu.candidate_pairs) return "candidate counts differ";
   if (cpu.filtered_tests != gpu.filtered_tests) return "filtered test counts differ";
   return {};
@@ -123,17 +125,13 @@ std::string difference(const detect::FilteredFrame& cpu, const detect::FilteredF
 
 /// Degenerate ids as the checker passes them (the uncertain ones are rare and left out here,
 /// the same way for both backends).
-std::vector<int32_t> degenerate_of(detect::Backend& backend) { return backend.scan_degenerate().degenerate; }
+std::vector<int32_t> degenerate_of(detect::Backend& backend) {
+  return backend.scan_degenerate().degenerate;
+}
 
-Row run_case(const Case& c, const BenchGpuOptions& o) {
-  std::cerr << "snag bench gpu: " << c.name << ": reading " << c.files.size() << " frames\n";
-  std::vector<mesh::Mesh> meshes;
-  for (const fs::path& f : c.files) meshes.push_back(io::read_mesh(f));
-  if (meshes.empty()) throw InputError(c.name, 0, "no frames");
+Row run_case(const BenchCase& c, const BenchGpuOptions& o) {
+  const std::vector<mesh::Mesh> meshes = read_case(c, "snag bench gpu").meshes;
   const mesh::Mesh& first = meshes.front();
-  for (const mesh::Mesh& m : meshes)
-    if (m.positions.size() != first.positions.size() || m.triangles.size() != first.triangles.size())
-      throw InputError(c.name, 0, "frames of a benchmark case must share one topology");
   const auto vertices = static_cast<int32_t>(first.positions.size());
   const detect::Topology topology = detect::make_topology(first.triangles, vertices);
 
@@ -148,7 +146,7 @@ Row run_case(const Case& c, const BenchGpuOptions& o) {
   auto cpu = detect::make_cpu_backend(o.threads);
   gpu->set_topology(topology);
   cpu->set_topology(topology);
-  std::vector<std::span<const geom::Vec3d>> frames;
+  std::vector<std::span<const geom::Vec3d> > frames;
   for (const mesh::Mesh& m : meshes) frames.emplace_back(m.positions);
   gpu->upload_resident_frames(frames);
 
@@ -258,76 +256,75 @@ Row run_case(const Case& c, const BenchGpuOptions& o) {
 }
 
 void print_tables(const std::vector<Row>& rows, const std::string& device, int threads) {
-  std::printf("snag bench gpu: %s; CPU backend with %d threads; milliseconds, medians over the timed frames\n",
-              device.c_str(), threads);
   std::printf(
-      "refit, quality, traverse, classify: each stage on its own; scan: the checker's scan with the refit and the "
-      "quality queued ahead of their calls;\nframe: scan, refit, quality, detect as the checker calls them, pairs back "
+      "snag bench gpu: %s; CPU backend with %d threads; milliseconds, medians over the timed "
+      "frames\n",
+      device.c_str(), threads);
+  std::printf(
+      "refit, quality, traverse, classify: each stage on its own; scan: the checker's scan with "
+      "the refit and the "
+      "quality queued ahead of their calls;\nframe: scan, refit, quality, detect as the checker "
+      "calls them, pairs back "
       "on the host (dev: positions on the device; host: uploaded from host memory first)\n\n");
-  std::printf("%-14s %8s %6s %8s %7s %7s %7s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "case", "tris", "timed",
-              "build", "refit", "quality", "scan", "traverse", "classify", "frame", "frame", "CPU build",
-              "CPU frame", "CPU/GPU", "pairs", "same");
-  std::printf("%-14s %8s %6s %8s %7s %7s %7s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "", "", "", "", "", "", "", "",
-              "", "dev", "host", "", "", "frame", "", "");
+  std::printf("%-14s %8s %6s %8s %7s %7s %7s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "case", "tris",
+              "timed", "build", "refit", "quality", "scan", "traverse", "classify", "frame",
+              "frame", "CPU build", "CPU frame", "CPU/GPU", "pairs", "same");
+  std::printf("%-14s %8s %6s %8s %7s %7s %7s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "", "", "", "",
+              "", "", "", "", "", "dev", "host", "", "", "frame", "", "");
   for (const Row& r : rows) {
-    std::printf("%-14s %8d %6d %8.3f %7.3f %7.3f %7.3f %8.3f %8.3f %8.3f %8.3f %9.2f %9.2f %7.0fx %8lld %5s\n",
-                r.name.c_str(), r.triangles, r.timed, r.build, r.refit, r.quality, r.scan, r.traverse, r.classify,
-                r.frame, r.frame_host, r.cpu_build, r.cpu_frame, r.frame > 0 ? r.cpu_frame / r.frame : 0.0,
-                static_cast<long long>(r.pairs), r.same ? "yes" : "NO");
+    std::printf(
+        "%-14s %8d %6d %8.3f %7.3f %7.3f %7.3f %8.3f %8.3f %8.3f %8.3f %9.2f %9.2f %7.0fx %8lld "
+        "%5s\n",
+        r.name.c_str(), r.triangles, r.timed, r.build, r.refit, r.quality, r.scan, r.traverse,
+        r.classify, r.frame, r.frame_host, r.cpu_build, r.cpu_frame,
+        r.frame > 0 ? r.cpu_frame / r.frame : 0.0, static_cast<long long>(r.pairs),
+        r.same ? "yes" : "NO");
     if (!r.note.empty()) std::printf("  %s\n", r.note.c_str());
   }
   std::printf("\nThe seed paper's table (GPU / CPU), for the same sizes:\n");
   std::printf("%9s %24s %22s %22s\n", "triangles", "build", "refit", "traverse");
-  std::printf("%9s %24s %22s %22s\n", "2,244", "23.94 ms / 5.71 ms", "0.16 us / 0.31 us", "1.19 ms / 10.28 ms");
-  std::printf("%9s %24s %22s %22s\n", "27,030", "59.12 ms / 45.18 ms", "0.18 us / 1.28 us", "12.52 ms / 162.92 ms");
-  std::printf("%9s %24s %22s %22s\n", "35,992", "0.21 s / 0.98 s", "0.35 us / 4.81 us", "0.41 s / 8.65 s");
+  std::printf("%9s %24s %22s %22s\n", "2,244", "23.94 ms / 5.71 ms", "0.16 us / 0.31 us",
+              "1.19 ms / 10.28 ms");
+  std::printf("%9s %24s %22s %22s\n", "27,030", "59.12 ms / 45.18 ms", "0.18 us / 1.28 us",
+              "12.52 ms / 162.92 ms");
+  std::printf("%9s %24s %22s %22s\n", "35,992", "0.21 s / 0.98 s", "0.35 us / 4.81 us",
+              "0.41 s / 8.65 s");
 }
 
 }  // namespace
 
 int run_bench_gpu(const BenchGpuOptions& o) {
   if (cuda_devices() == 0)
-    throw DeviceUnavailable("bench gpu: no CUDA device is usable here (no NVIDIA GPU, or no driver for it)");
+    throw DeviceUnavailable(
+        "bench gpu: no CUDA device is usable here (no NVIDIA GPU, or no driver for it)");
   ScratchDir scratch;
-  std::vector<Case> cases;
+  std::vector<BenchCase> cases;
   const fs::path data = data_folder(o.data_dir);
-  const std::pair<const char*, const char*> shared[] = {{"cloth-ball", "scalable-ccd/cloth-ball"},
-                                                         {"n-body", "scalable-ccd/n-body-simulation"}};
-  for (const auto& [name, folder] : shared) {
-    const fs::path dir = data / folder;
-    if (!data.empty() && fs::is_directory(dir)) {
-      Case c{name, {}};
-      for (const seq::Frame& f : seq::resolve_sequence(dir.string())) c.files.push_back(f.path);
-      cases.push_back(std::move(c));
-    } else if (!o.data_dir.empty()) {
-      throw UsageError("--data " + o.data_dir + ": no " + folder + " folder in it");
-    } else {
-      std::cerr << "snag bench gpu: no shared data folder (" << dir.string() << "); the " << name
-                << " case is left out\n";
-    }
-  }
-  for (const std::string& input : o.inputs) {
-    Case c{fs::path(input).filename().string(), {}};
-    for (const seq::Frame& f : seq::resolve_sequence(input)) c.files.push_back(f.path);
-    cases.push_back(std::move(c));
-  }
+  add_data_case(cases, data, o.data_dir, "cloth-ball", "scalable-ccd/cloth-ball", "snag bench gpu");
+  add_data_case(cases, data, o.data_dir, "n-body", "scalable-ccd/n-body-simulation",
+                "snag bench gpu");
+  for (const std::string& input : o.inputs)
+    cases.push_back(sequence_case(fs::path(input).filename().string(), input));
   // Generated cases: the paper's sizes folded on the sphere (settled, 4 frames cycled), then the
   // large cloth from its first 2 frames (settling a million triangles takes minutes).
-  std::vector<Case> generated;
+  std::vector<BenchCase> generated;
   for (int size : o.sizes) {
     if (size <= 0) continue;
     const fs::path dir = scratch.path() / std::to_string(size);
-    generated.push_back({"cloth " + std::to_string(size), generated_cloth(o.generator, size, settle_frames, 4, dir)});
+    generated.push_back({"cloth " + std::to_string(size),
+                         generated_cloth(o.generator, size, settle_frames, 4, dir)});
   }
   if (o.large > 0) {
     const fs::path dir = scratch.path() / "large";
-    cases.push_back({"cloth " + std::to_string(o.large), generated_cloth(o.generator, o.large, 0, 2, dir)});
+    cases.push_back(
+        {"cloth " + std::to_string(o.large), generated_cloth(o.generator, o.large, 0, 2, dir)});
   }
   cases.insert(cases.begin(), generated.begin(), generated.end());
-  if (cases.empty()) throw UsageError("nothing to time: no --sizes, no --large, no data folder, no --input");
+  if (cases.empty())
+    throw UsageError("nothing to time: no --sizes, no --large, no data folder, no --input");
 
   std::vector<Row> rows;
-  for (const Case& c : cases) rows.push_back(run_case(c, o));
+  for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
   auto probe = make_backend("cuda", o.threads, o.device);
   print_tables(rows, dynamic_cast<cuda::CudaBackend&>(*probe).device_name(),
                o.threads > 0 ? o.threads : omp_get_max_threads());

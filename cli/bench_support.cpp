@@ -6,11 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <iostream>
 #include <random>
 
 #include "snag/error.h"
+#include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
 
 extern char** environ;
@@ -28,7 +30,8 @@ double median(std::vector<double> v) {
 
 ScratchDir::ScratchDir() {
   std::random_device rd;
-  path_ = fs::temp_directory_path() / ("snag-bench-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+  path_ = fs::temp_directory_path() /
+          ("snag-bench-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
   fs::create_directories(path_);
 }
 
@@ -42,8 +45,8 @@ std::string find_generator(const std::string& given) {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    for (const fs::path& candidate :
-         {self.parent_path() / "snag-cloth", self.parent_path().parent_path() / "samples" / "snag-cloth"})
+    for (const fs::path& candidate : {self.parent_path() / "snag-cloth",
+                                      self.parent_path().parent_path() / "samples" / "snag-cloth"})
       if (fs::exists(candidate, ec)) return candidate.string();
   }
   return "snag-cloth";
@@ -63,7 +66,8 @@ void run_program(const std::vector<std::string>& args) {
   const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (spawned != 0)
-    throw UsageError("cannot run the sample generator '" + args[0] + "' (build it, or give its path with --generator)");
+    throw UsageError("cannot run the sample generator '" + args[0] +
+                     "' (build it, or give its path with --generator)");
   int status = 0;
   if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw InternalError("the sample generator '" + args[0] + "' failed");
@@ -71,13 +75,15 @@ void run_program(const std::vector<std::string>& args) {
 
 }  // namespace
 
-std::vector<fs::path> generated_cloth(const std::string& generator, int triangles, int settle, int keep,
-                                      const fs::path& dir) {
+std::vector<fs::path> generated_cloth(const std::string& generator, int triangles, int settle,
+                                      int keep, const fs::path& dir) {
   keep = std::max(1, keep);
   const int total = settle + keep;
-  std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total << " frames\n";
-  run_program({find_generator(generator), "--triangles", std::to_string(triangles), "--frames", std::to_string(total),
-               "--output-dir", dir.string(), "--prefix", "cloth", "--quiet"});
+  std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total
+            << " frames\n";
+  run_program({find_generator(generator), "--triangles", std::to_string(triangles), "--frames",
+               std::to_string(total), "--output-dir", dir.string(), "--prefix", "cloth",
+               "--quiet"});
   std::vector<fs::path> files;
   for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
   if (files.size() > static_cast<size_t>(keep)) files.erase(files.begin(), files.end() - keep);
@@ -92,6 +98,46 @@ fs::path data_folder(const std::string& given) {
 #else
   return {};
 #endif
+}
+
+BenchCase sequence_case(std::string name, const std::string& sequence) {
+  BenchCase c{std::move(name), {}};
+  for (const seq::Frame& f : seq::resolve_sequence(sequence)) c.files.push_back(f.path);
+  return c;
+}
+
+void add_data_case(std::vector<BenchCase>& cases, const std::filesystem::path& data,
+                   const std::string& given, const std::string& name, const std::string& folder,
+                   std::string_view command) {
+  const std::filesystem::path dir = data / folder;
+  if (!data.empty() && std::filesystem::is_directory(dir)) {
+    cases.push_back(sequence_case(name, dir.string()));
+  } else if (!given.empty()) {
+    throw UsageError("--data " + given + ": no " + folder + " folder in it");
+  } else {
+    std::cerr << command << ": no shared data folder (" << dir.string() << "); the " << name
+              << " case is left out\n";
+  }
+}
+
+CaseFrames read_case(const BenchCase& c, std::string_view command) {
+  using Clock = std::chrono::steady_clock;
+  std::cerr << command << ": " << c.name << ": reading " << c.files.size() << " frames\n";
+  CaseFrames frames;
+  for (const std::filesystem::path& f : c.files) {
+    io::read_mesh(f);
+    const auto started = Clock::now();
+    frames.meshes.push_back(io::read_mesh(f));
+    frames.read_seconds.push_back(std::chrono::duration<double>(Clock::now() - started).count());
+    frames.read_bytes.push_back(static_cast<double>(std::filesystem::file_size(f)));
+  }
+  if (frames.meshes.empty()) throw InputError(c.name, 0, "no frames");
+  const mesh::Mesh& first = frames.meshes.front();
+  for (const mesh::Mesh& m : frames.meshes)
+    if (m.positions.size() != first.positions.size() ||
+        m.triangles.size() != first.triangles.size())
+      throw InputError(c.name, 0, "frames of a benchmark case must share one topology");
+  return frames;
 }
 
 }  // namespace snag::cli

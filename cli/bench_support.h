@@ -3,7 +3,10 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "snag/mesh/mesh.h"
 
 namespace snag::cli {
 
@@ -33,11 +36,38 @@ std::string find_generator(const std::string& given);
 
 /// Generates a cloth of about `triangles` triangles into `dir` with `settle` + `keep` frames and
 /// returns the last `keep` frame files.
-std::vector<std::filesystem::path> generated_cloth(const std::string& generator, int triangles, int settle, int keep,
+std::vector<std::filesystem::path> generated_cloth(const std::string& generator, int triangles,
+                                                   int settle, int keep,
                                                    const std::filesystem::path& dir);
 
 /// The shared data folder: `given` (--data), else $SNAG_DATA_DIR, else the one known at build
 /// time; empty when none is known.
 std::filesystem::path data_folder(const std::string& given);
+
+/// One benchmark case: a name and its frame files, which share one topology.
+struct BenchCase {
+  std::string name;
+  std::vector<std::filesystem::path> files;
+};
+
+/// A case of the frames of a sequence (a file, folder, pattern or glob, as `snag check` takes).
+BenchCase sequence_case(std::string name, const std::string& sequence);
+
+/// Appends the case `name` made of the shared data folder's `folder`, when it is there. When it
+/// is not: a usage error if the user named the data folder (`given`), else a note on standard
+/// error that the case is left out.
+void add_data_case(std::vector<BenchCase>& cases, const std::filesystem::path& data,
+                   const std::string& given, const std::string& name, const std::string& folder,
+                   std::string_view command);
+
+/// A case's frames, read. Each file is read twice and the second read timed, so that the time
+/// is snag's reader on a file in the page cache, not the disk. Throws InputError unless every
+/// frame has the first one's vertex and triangle counts.
+struct CaseFrames {
+  std::vector<mesh::Mesh> meshes;
+  std::vector<double> read_seconds;  ///< per frame
+  std::vector<double> read_bytes;    ///< per frame: the file's size
+};
+CaseFrames read_case(const BenchCase& c, std::string_view command);
 
 }  // namespace snag::cli
