@@ -37,8 +37,9 @@ std::unique_ptr<detect::Backend> make_cuda(int device) {
         "--backend cuda: no CUDA device is usable here (no NVIDIA GPU, or no driver for it); "
         "use --backend cpu (or auto)");
   if (device < 0 || device >= count)
-    throw DeviceUnavailable("--device " + std::to_string(device) + ": this machine has " + std::to_string(count) +
-                            " CUDA device" + (count == 1 ? "" : "s") + ", numbered from 0");
+    throw DeviceUnavailable("--device " + std::to_string(device) + ": this machine has " +
+                            std::to_string(count) + " CUDA device" + (count == 1 ? "" : "s") +
+                            ", numbered from 0");
   return cuda::make_cuda_backend(device);
 #else
   (void)device;
@@ -57,7 +58,8 @@ std::unique_ptr<detect::Backend> make_backend(std::string_view name, int threads
     if (cuda_built() && cuda_devices() > 0) return make_cuda(device);
     return detect::make_cpu_backend(threads);
   }
-  throw UsageError("--backend: unknown backend '" + std::string(name) + "' (expected auto, cpu or cuda)");
+  throw UsageError("--backend: unknown backend '" + std::string(name) +
+                   "' (expected auto, cpu or cuda)");
 }
 
 }  // namespace snag::cli

@@ -145,9 +145,10 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("FACTOR")
       ->check(CLI::Range(1.0, 1e9))
       ->capture_default_str();
-  cmd->add_option("--backend", o.backend,
-                  "Detection backend: auto (the GPU when snag has CUDA and a device is present, else "
-                  "the CPU), cpu, or cuda (exit status 4 when not built or no device)")
+  cmd->add_option(
+         "--backend", o.backend,
+         "Detection backend: auto (the GPU when snag has CUDA and a device is present, else "
+         "the CPU), cpu, or cuda (exit status 4 when not built or no device)")
       ->type_name("NAME")
       ->check(CLI::IsMember(
           std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))

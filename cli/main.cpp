@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
     snag::cli::BenchOptions bench;
     CLI::App* bench_cpu_command = snag::cli::add_bench_command(app, bench);
     snag::cli::BenchGpuOptions bench_gpu;
-    CLI::App* bench_gpu_command = snag::cli::add_bench_gpu_command(*app.get_subcommand("bench"), bench_gpu);
+    CLI::App* bench_gpu_command =
+        snag::cli::add_bench_gpu_command(*app.get_subcommand("bench"), bench_gpu);
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "

@@ -31,49 +31,87 @@ inline std::vector<Case> cases() {
     p.insert(p.end(), more.begin(), more.end());
     return p;
   };
-  all.push_back({"shared edge folded flat", {with({{4, 4, 0}}), {{{0, 1, 2}}, {{0, 1, 3}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"shared edge flat continuation", {with({{4, -4, 0}}), {{{0, 1, 2}}, {{1, 0, 3}}}}, {}, {}});
+  all.push_back({"shared edge folded flat",
+                 {with({{4, 4, 0}}), {{{0, 1, 2}}, {{0, 1, 3}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back(
+      {"shared edge flat continuation", {with({{4, -4, 0}}), {{{0, 1, 2}}, {{1, 0, 3}}}}, {}, {}});
   all.push_back({"shared edge hinge", {with({{4, 4, 5}}), {{{0, 1, 2}}, {{0, 1, 3}}}}, {}, {}});
   all.push_back({"shared vertex, opposite edge piercing",
-                 {with({{2, 2, -2}, {2, 2, 2}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {{0, 1, kCrossing}}, {}});
-  all.push_back({"shared vertex only", {with({{-2, -2, 3}, {-3, 1, 4}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {}, {}});
+                 {with({{2, 2, -2}, {2, 2, 2}}), {{{0, 1, 2}}, {{0, 3, 4}}}},
+                 {{0, 1, kCrossing}},
+                 {}});
+  all.push_back({"shared vertex only",
+                 {with({{-2, -2, 3}, {-3, 1, 4}}), {{{0, 1, 2}}, {{0, 3, 4}}}},
+                 {},
+                 {}});
   all.push_back({"shared vertex, edge lying in the face",
-                 {with({{2, 2, 0}, {1, 1, 5}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {{0, 1, kTouching}}, {}});
+                 {with({{2, 2, 0}, {1, 1, 5}}), {{{0, 1, 2}}, {{0, 3, 4}}}},
+                 {{0, 1, kTouching}},
+                 {}});
   all.push_back({"shared vertex, coplanar outside the angle",
-                 {with({{-2, -2, 0}, {-4, 1, 0}}), {{{0, 1, 2}}, {{0, 3, 4}}}}, {}, {}});
-  all.push_back({"coplanar overlap", {with({{1, 1, 0}, {12, 1, 0}, {1, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"coplanar, one inside the other", {with({{1, 1, 0}, {3, 1, 0}, {1, 3, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"coplanar apart", {with({{9, 9, 0}, {12, 9, 0}, {9, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {}, {}});
-  all.push_back({"vertex exactly on the face", {with({{2, 2, 0}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"vertex exactly on an edge", {with({{4, 0, 0}, {5, -1, 4}, {4, 1, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kTouching}}, {}});
-  all.push_back({"vertex a hair above the face", {with({{2, 2, 1}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {}, {}});
+                 {with({{-2, -2, 0}, {-4, 1, 0}}), {{{0, 1, 2}}, {{0, 3, 4}}}},
+                 {},
+                 {}});
+  all.push_back({"coplanar overlap",
+                 {with({{1, 1, 0}, {12, 1, 0}, {1, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back({"coplanar, one inside the other",
+                 {with({{1, 1, 0}, {3, 1, 0}, {1, 3, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back({"coplanar apart",
+                 {with({{9, 9, 0}, {12, 9, 0}, {9, 12, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {},
+                 {}});
+  all.push_back({"vertex exactly on the face",
+                 {with({{2, 2, 0}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back({"vertex exactly on an edge",
+                 {with({{4, 0, 0}, {5, -1, 4}, {4, 1, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back({"vertex a hair above the face",
+                 {with({{2, 2, 1}, {3, 2, 4}, {2, 3, 4}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {},
+                 {}});
   all.push_back({"edge exactly through an edge",
-                 {with({{4, -2, 0}, {4, 2, 0}, {4, 0, 6}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
+                 {with({{4, -2, 0}, {4, 2, 0}, {4, 0, 6}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
   // X's edge 3-4 crosses F's edge 0-1 at (4, 0, 0), and X meets F's plane along a segment
   // that leaves F there: both straddle, contact at one point.
   all.push_back({"edge across an edge at a point",
-                 {with({{4, -2, -2}, {4, 2, 2}, {6, -4, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
+                 {with({{4, -2, -2}, {4, 2, 2}, {6, -4, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
   all.push_back({"segment contact without passing through",
-                 {with({{1, 1, 0}, {3, 1, 0}, {2, 1, 5}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
-  all.push_back({"proper crossing", {with({{1, 1, -3}, {3, 1, 3}, {2, 4, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
-                 {{0, 1, kCrossing}}, {}});
+                 {with({{1, 1, 0}, {3, 1, 0}, {2, 1, 5}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
+  all.push_back({"proper crossing",
+                 {with({{1, 1, -3}, {3, 1, 3}, {2, 4, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kCrossing}},
+                 {}});
   // Both straddle, and the two segments on the planes' line meet only at an end: (4, 0, 0).
   all.push_back({"straddling, segments meet at one point",
-                 {with({{4, -4, -4}, {4, -4, 4}, {4, 0, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {{0, 1, kTouching}}, {}});
+                 {with({{4, -4, -4}, {4, -4, 4}, {4, 0, 0}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {{0, 1, kTouching}},
+                 {}});
   all.push_back({"duplicated face", {base, {{{0, 1, 2}}, {{1, 2, 0}}}}, {{0, 1, kTouching}}, {}});
   all.push_back({"zero-area face through a triangle",
-                 {with({{1, 1, -3}, {2, 2, 0}, {3, 3, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}}, {}, {1}});
+                 {with({{1, 1, -3}, {2, 2, 0}, {3, 3, 3}}), {{{0, 1, 2}}, {{3, 4, 5}}}},
+                 {},
+                 {1}});
   all.push_back({"repeated corner", {with({{1, 1, -3}}), {{{0, 1, 2}}, {{3, 3, 0}}}}, {}, {1}});
   return all;
 }
 
 inline constexpr int kIdentity[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-inline constexpr int kShear[3][3] = {{1, 2, 0}, {0, 1, 3}, {1, 0, 1}};       // det 7
+inline constexpr int kShear[3][3] = {{1, 2, 0}, {0, 1, 3}, {1, 0, 1}};    // det 7
 inline constexpr int kMirror[3][3] = {{0, 1, 0}, {1, 0, 0}, {-2, 3, 1}};  // det -1: a reflection
 
 /// Every pair of non-degenerate triangles, decided straight from the definition (an edge of
@@ -85,15 +123,17 @@ inline std::vector<detect::FacePair> brute_force(const SmallMesh& mesh) {
   std::vector<uint8_t> degenerate(static_cast<size_t>(n));
   for (int32_t t = 0; t < n; ++t) {
     const geom::Tri& tri = mesh.triangles[t];
-    degenerate[t] = IntegerResolver::decide(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
+    degenerate[t] =
+        IntegerResolver::decide(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
   }
   auto edge_hits = [&](const geom::Tri& f, const geom::Tri& x) {
     for (int k = 0; k < 3; ++k) {
       const int32_t p = f.v[k], q = f.v[(k + 1) % 3];
-      const bool p_in = p == x.v[0] || p == x.v[1] || p == x.v[2], q_in = q == x.v[0] || q == x.v[1] || q == x.v[2];
+      const bool p_in = p == x.v[0] || p == x.v[1] || p == x.v[2],
+                 q_in = q == x.v[0] || q == x.v[1] || q == x.v[2];
       if (p_in && q_in) continue;
-      if (IntegerResolver::decide(geom::edge_hits_triangle(pred, p, q, x, IntegerResolver::side(pred, x, p),
-                                                           IntegerResolver::side(pred, x, q))))
+      if (IntegerResolver::decide(geom::edge_hits_triangle(
+              pred, p, q, x, IntegerResolver::side(pred, x, p), IntegerResolver::side(pred, x, q))))
         return true;
     }
     return false;
@@ -123,8 +163,10 @@ inline SmallMesh lattice_soup(int32_t triangles, int32_t vertices, int range, ui
   std::uniform_int_distribution<int> coord(0, range);
   std::uniform_int_distribution<int32_t> pick(0, vertices - 1);
   SmallMesh mesh;
-  for (int32_t v = 0; v < vertices; ++v) mesh.positions.push_back({double(coord(rng)), double(coord(rng)), double(coord(rng))});
-  for (int32_t t = 0; t < triangles; ++t) mesh.triangles.push_back({{pick(rng), pick(rng), pick(rng)}});
+  for (int32_t v = 0; v < vertices; ++v)
+    mesh.positions.push_back({double(coord(rng)), double(coord(rng)), double(coord(rng))});
+  for (int32_t t = 0; t < triangles; ++t)
+    mesh.triangles.push_back({{pick(rng), pick(rng), pick(rng)}});
   return mesh;
 }
 
@@ -134,7 +176,8 @@ inline SmallMesh folded_grid(int w, int h) {
   for (int j = 0; j <= h; ++j)
     for (int i = 0; i <= w; ++i) {
       const int fold = (i * 3) % (2 * w);  // zig-zag in x: the sheet passes through itself
-      mesh.positions.push_back({double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)});
+      mesh.positions.push_back(
+          {double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)});
     }
   auto id = [&](int i, int j) { return j * (w + 1) + i; };
   for (int j = 0; j < h; ++j)

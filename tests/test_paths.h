@@ -22,7 +22,8 @@ inline std::filesystem::path data_dir() {
   std::filesystem::path dir;
   if (const char* env = std::getenv("SNAG_DATA_DIR"); env && *env) dir = env;
 #ifdef SNAG_DATA_DIR_DEFAULT
-  else dir = SNAG_DATA_DIR_DEFAULT;
+  else
+    dir = SNAG_DATA_DIR_DEFAULT;
 #endif
   if (dir.empty() || !std::filesystem::is_directory(dir)) return {};
   return dir;

@@ -35,7 +35,8 @@ template <class T>
 void upload(DeviceBuffer<T>& buffer, const T* data, size_t count, cudaStream_t stream) {
   buffer.reserve(std::max<size_t>(count, 1));
   if (count)
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(buffer.data(), data, count * sizeof(T), cudaMemcpyHostToDevice, stream));
+    SNAG_CUDA_CHECK(
+        cudaMemcpyAsync(buffer.data(), data, count * sizeof(T), cudaMemcpyHostToDevice, stream));
 }
 
 /// Makes `device` current before any other member creates a CUDA object.
@@ -63,7 +64,8 @@ class CudaBackendImpl final : public CudaBackend {
   }
   void set_result_capacity(int64_t entries) override {
     initial_capacity_ = std::max<int64_t>(entries, 1);
-    finish_limit_ = std::min<unsigned long long>(kFinishLimit, static_cast<unsigned long long>(initial_capacity_));
+    finish_limit_ = std::min<unsigned long long>(
+        kFinishLimit, static_cast<unsigned long long>(initial_capacity_));
   }
   void set_level_by_level_refit(bool on) override { tree_.level_by_level_refit = on; }
   void start_timer() override { span_timer_.start(stream()); }
@@ -82,7 +84,8 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.edges, topology.edges.data(), topology.edges.size(), s);
     upload(d.triangle_edges, topology.triangle_edges.data(), n, s);
     upload(d.owned_edges, topology.owned_edges.data(), n, s);
-    upload(d.edge_face_offsets, topology.edge_face_offsets.data(), topology.edge_face_offsets.size(), s);
+    upload(d.edge_face_offsets, topology.edge_face_offsets.data(),
+           topology.edge_face_offsets.size(), s);
     upload(d.edge_faces, topology.edge_faces.data(), topology.edge_faces.size(), s);
     upload(d.listed_vertex, topology.listed_vertex.data(), topology.listed_vertex.size(), s);
     upload(d.neighbor_pairs, topology.neighbor_pairs.data(), topology.neighbor_pairs.size(), s);
@@ -97,8 +100,8 @@ class CudaBackendImpl final : public CudaBackend {
     host_keys_.reserve(kFinishLimit);
     host_status_.reserve(kFinishLimit);
     host_uncertain_.reserve(kFinishLimit);
-    host_results_ = {mapped(host_keys_.data()), mapped(host_status_.data()), mapped(host_uncertain_.data()),
-                     mapped(counters_host_.data()), 0};
+    host_results_ = {mapped(host_keys_.data()), mapped(host_status_.data()),
+                     mapped(host_uncertain_.data()), mapped(counters_host_.data()), 0};
     planes_.reserve(std::max<size_t>(n, 1));
     positions_.reserve(std::max<int32_t>(d.vertex_count, 1));
     positions_host_.reserve(std::max<int32_t>(d.vertex_count, 1));
@@ -108,7 +111,8 @@ class CudaBackendImpl final : public CudaBackend {
     tree_.resize(d.triangle_count);
     tree_built_ = false;
     quality_ready_ = false;
-    ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_, initial_capacity_);
+    ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
+                           initial_capacity_);
     stream_->synchronize();
   }
 
@@ -122,8 +126,8 @@ class CudaBackendImpl final : public CudaBackend {
     if (upload_pending_) upload_timer_.elapsed();
     std::memcpy(positions_host_.data(), positions.data(), positions.size_bytes());
     upload_timer_.start(stream());
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_.data(), positions_host_.data(), positions.size_bytes(),
-                                    cudaMemcpyHostToDevice, stream()));
+    SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_.data(), positions_host_.data(),
+                                    positions.size_bytes(), cudaMemcpyHostToDevice, stream()));
     upload_timer_.stop_async(stream());
     upload_pending_ = true;
     current_positions_ = positions_.data();
@@ -135,16 +139,19 @@ class CudaBackendImpl final : public CudaBackend {
     const size_t v = static_cast<size_t>(topo_.vertex_count);
     resident_.reserve(std::max<size_t>(frames.size() * v, 1));
     for (size_t f = 0; f < frames.size(); ++f) {
-      if (frames[f].size() != v) throw InternalError("cuda backend: a resident frame has the wrong vertex count");
-      SNAG_CUDA_CHECK(cudaMemcpy(resident_.data() + f * v, frames[f].data(), v * sizeof(geom::Vec3d),
-                                 cudaMemcpyHostToDevice));
+      if (frames[f].size() != v)
+        throw InternalError("cuda backend: a resident frame has the wrong vertex count");
+      SNAG_CUDA_CHECK(cudaMemcpy(resident_.data() + f * v, frames[f].data(),
+                                 v * sizeof(geom::Vec3d), cudaMemcpyHostToDevice));
     }
     resident_count_ = static_cast<int>(frames.size());
   }
 
   void select_resident_frame(int index) override {
-    if (index < 0 || index >= resident_count_) throw InternalError("cuda backend: no resident frame " + std::to_string(index));
-    current_positions_ = resident_.data() + static_cast<size_t>(index) * static_cast<size_t>(topo_.vertex_count);
+    if (index < 0 || index >= resident_count_)
+      throw InternalError("cuda backend: no resident frame " + std::to_string(index));
+    current_positions_ =
+        resident_.data() + static_cast<size_t>(index) * static_cast<size_t>(topo_.vertex_count);
     ++positions_version_;
   }
 
@@ -159,7 +166,8 @@ class CudaBackendImpl final : public CudaBackend {
     const cudaStream_t s = stream();
     timer_.start(s);
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    launch_scan_degenerate(current_positions_, topo_.triangles.data(), n, mapped(scan_degenerate_host_.data()),
+    launch_scan_degenerate(current_positions_, topo_.triangles.data(), n,
+                           mapped(scan_degenerate_host_.data()),
                            mapped(scan_uncertain_host_.data()), counters_.data(), s);
     SNAG_CUDA_CHECK(cudaMemcpyAsync(counters_host_.data(), counters_.data(), sizeof(FrameCounters),
                                     cudaMemcpyDeviceToHost, s));
@@ -176,8 +184,10 @@ class CudaBackendImpl final : public CudaBackend {
       quality_ready_ = true;
     }
     const FrameCounters c = *counters_host_.data();
-    scan.degenerate.assign(scan_degenerate_host_.data(), scan_degenerate_host_.data() + c.degenerate);
-    scan.uncertain.assign(scan_uncertain_host_.data(), scan_uncertain_host_.data() + c.degenerate_uncertain);
+    scan.degenerate.assign(scan_degenerate_host_.data(),
+                           scan_degenerate_host_.data() + c.degenerate);
+    scan.uncertain.assign(scan_uncertain_host_.data(),
+                          scan_uncertain_host_.data() + c.degenerate_uncertain);
     // Appended in any order: sorted as the CPU gives them.
     std::sort(scan.degenerate.begin(), scan.degenerate.end());
     std::sort(scan.uncertain.begin(), scan.uncertain.end());
@@ -224,8 +234,8 @@ class CudaBackendImpl final : public CudaBackend {
     stream_->synchronize();  // a build may still be queued
     std::vector<int32_t> order(static_cast<size_t>(tree_.shape().leaf_count));
     if (!order.empty())
-      SNAG_CUDA_CHECK(cudaMemcpy(order.data(), tree_.view().triangle_at, order.size() * sizeof(int32_t),
-                                 cudaMemcpyDeviceToHost));
+      SNAG_CUDA_CHECK(cudaMemcpy(order.data(), tree_.view().triangle_at,
+                                 order.size() * sizeof(int32_t), cudaMemcpyDeviceToHost));
     return order;
   }
 
@@ -234,8 +244,8 @@ class CudaBackendImpl final : public CudaBackend {
     const int32_t n = tree_.shape().leaf_count;
     std::vector<geom::Box3f> boxes(n > 0 ? static_cast<size_t>(2 * n - 1) : 0);
     if (!boxes.empty())
-      SNAG_CUDA_CHECK(cudaMemcpy(boxes.data(), tree_.view().boxes, boxes.size() * sizeof(geom::Box3f),
-                                 cudaMemcpyDeviceToHost));
+      SNAG_CUDA_CHECK(cudaMemcpy(boxes.data(), tree_.view().boxes,
+                                 boxes.size() * sizeof(geom::Box3f), cudaMemcpyDeviceToHost));
     return boxes;
   }
 
@@ -272,7 +282,8 @@ class CudaBackendImpl final : public CudaBackend {
 
   /// Result buffers for at least these counts. Never shrinks, so a sequence allocates only
   /// while its counts grow; the pair set's table is a power of two at least twice the pairs.
-  void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates, uint64_t pairs) {
+  void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates,
+                              uint64_t pairs) {
     hits_.reserve(hits);
     uncertain_.reserve(uncertain);
     duplicates_.reserve(duplicates);
@@ -334,17 +345,19 @@ class CudaBackendImpl final : public CudaBackend {
 const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> degenerate) {
   const cudaStream_t s = stream();
   const size_t n = static_cast<size_t>(topo_.triangle_count);
-  const bool same = flagged_.size() == degenerate.size() && std::equal(flagged_.begin(), flagged_.end(), degenerate.begin());
+  const bool same = flagged_.size() == degenerate.size() &&
+                    std::equal(flagged_.begin(), flagged_.end(), degenerate.begin());
   if (!same) {
     if (!flagged_.empty()) SNAG_CUDA_CHECK(cudaMemsetAsync(topo_.degenerate.data(), 0, n, s));
     if (!degenerate.empty()) {
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(topo_.degenerate_list.data(), degenerate.data(), degenerate.size_bytes(),
-                                      cudaMemcpyHostToDevice, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(topo_.degenerate_list.data(), degenerate.data(),
+                                      degenerate.size_bytes(), cudaMemcpyHostToDevice, s));
       launch_flag_degenerate(topo_.degenerate_list.data(), static_cast<int32_t>(degenerate.size()),
                              topo_.degenerate.data(), s);
       // Degenerate triangles own nothing this frame: their edges go to the next incident face.
       const std::vector<uint8_t> owned = detect::ownership_without(*topology_, degenerate);
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(topo_.frame_owned_edges.data(), owned.data(), n, cudaMemcpyHostToDevice, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(topo_.frame_owned_edges.data(), owned.data(), n,
+                                      cudaMemcpyHostToDevice, s));
       stream_->synchronize();  // `owned` is a local: the copy must finish before it goes
     }
     flagged_.assign(degenerate.begin(), degenerate.end());
@@ -396,26 +409,31 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     results.duplicate_capacity = duplicates_.capacity();
     results.counters = counters_.data();
     results.edge_face_offsets = topo_.edge_face_offsets.data();
-    PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(), pair_keys_.capacity()};
+    PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
+                pair_keys_.capacity()};
     HostResults out = host_results_;
     out.limit = finish_limit_;
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    SNAG_CUDA_CHECK(cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
-    launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(), topo_.neighbor_shared.data(),
-                        topo_.neighbor_pair_count, results, s);
+    SNAG_CUDA_CHECK(
+        cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
+    launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(),
+                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, s);
     narrow_timer_.stop_async(s);
-    launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(), counters_.data(),
-                  topo_.edge_face_offsets.data(), topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_,
-                  current_positions_, topo_.triangles.data(), set, s);
-    launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), key_bits, task_bits, out, s);
+    launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
+                  counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),
+                  topo_.degenerate.data(), pair_bits_, current_positions_, topo_.triangles.data(),
+                  set, s);
+    launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), key_bits,
+                  task_bits, out, s);
     timer_.stop_async(s);
     timer_.elapsed();  // the wait
     c = *host_counters;
-    if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() && c.duplicates <= duplicates_.capacity() &&
-        c.pairs <= pair_keys_.capacity())
+    if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
+        c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity())
       break;
     // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits.
-    ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates), grown(c.expanded + c.duplicates));
+    ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
+                           grown(c.expanded + c.duplicates));
     timer_.start(s);
   }
   collect_times();
@@ -441,14 +459,15 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     tasks_alt_.reserve(std::max<size_t>(c.uncertain, 1));
     size_t need = 0, bytes = 0;
     if (large_pairs) {
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, pair_keys_.data(), keys_alt_.data(),
-                                                      pair_status_.data(), status_alt_.data(),
-                                                      static_cast<int64_t>(c.pairs), 0, key_bits, s));
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
+          nullptr, bytes, pair_keys_.data(), keys_alt_.data(), pair_status_.data(),
+          status_alt_.data(), static_cast<int64_t>(c.pairs), 0, key_bits, s));
       need = std::max(need, bytes);
     }
     if (large_tasks) {
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(nullptr, bytes, uncertain_.data(), tasks_alt_.data(),
-                                                     static_cast<int64_t>(c.uncertain), 0, task_bits, s));
+      SNAG_CUDA_CHECK(
+          cub::DeviceRadixSort::SortKeys(nullptr, bytes, uncertain_.data(), tasks_alt_.data(),
+                                         static_cast<int64_t>(c.uncertain), 0, task_bits, s));
       need = std::max(need, bytes);
     }
     temp_.reserve(std::max<size_t>(need, 1));
@@ -456,22 +475,24 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
       keys_host_.reserve(c.pairs);
       status_host_.reserve(c.pairs);
       bytes = temp_.capacity();
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, pair_keys_.data(), keys_alt_.data(),
-                                                      pair_status_.data(), status_alt_.data(),
-                                                      static_cast<int64_t>(c.pairs), 0, key_bits, s));
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(keys_host_.data(), keys_alt_.data(), c.pairs * sizeof(uint64_t),
+      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
+          temp_.data(), bytes, pair_keys_.data(), keys_alt_.data(), pair_status_.data(),
+          status_alt_.data(), static_cast<int64_t>(c.pairs), 0, key_bits, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(keys_host_.data(), keys_alt_.data(),
+                                      c.pairs * sizeof(uint64_t), cudaMemcpyDeviceToHost, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(status_host_.data(), status_alt_.data(), c.pairs,
                                       cudaMemcpyDeviceToHost, s));
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(status_host_.data(), status_alt_.data(), c.pairs, cudaMemcpyDeviceToHost, s));
       keys = keys_host_.data();
       statuses = status_host_.data();
     }
     if (large_tasks) {
       uncertain_host_.reserve(c.uncertain);
       bytes = temp_.capacity();
-      SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, uncertain_.data(), tasks_alt_.data(),
-                                                     static_cast<int64_t>(c.uncertain), 0, task_bits, s));
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(uncertain_host_.data(), tasks_alt_.data(), c.uncertain * sizeof(uint64_t),
-                                      cudaMemcpyDeviceToHost, s));
+      SNAG_CUDA_CHECK(
+          cub::DeviceRadixSort::SortKeys(temp_.data(), bytes, uncertain_.data(), tasks_alt_.data(),
+                                         static_cast<int64_t>(c.uncertain), 0, task_bits, s));
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(uncertain_host_.data(), tasks_alt_.data(),
+                                      c.uncertain * sizeof(uint64_t), cudaMemcpyDeviceToHost, s));
       tasks = uncertain_host_.data();
     }
     timer_.stop_async(s);
@@ -495,16 +516,18 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     const uint64_t key = tasks[i];
     frame.uncertain[i] = {static_cast<int32_t>(key >> 32), static_cast<int32_t>(key & 0xffffffffu)};
   }
-  frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) + static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
+  frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) +
+                         static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
   frame.classify_seconds = seconds_since(classify_start);
   {
     // Next frames start with this one's counts and some slack, so that creeping counts
     // rarely run a frame twice. Only now: growing discards the buffers' contents.
-    const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain), duplicates = grown(c.duplicates),
-                   pairs = grown(c.expanded + c.duplicates);
-    if (hits > hits_.capacity() || uncertain > uncertain_.capacity() || duplicates > duplicates_.capacity() ||
-        pairs > pair_keys_.capacity())
-      ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()), std::max<uint64_t>(uncertain, uncertain_.capacity()),
+    const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain),
+                   duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates);
+    if (hits > hits_.capacity() || uncertain > uncertain_.capacity() ||
+        duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity())
+      ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()),
+                             std::max<uint64_t>(uncertain, uncertain_.capacity()),
                              std::max<uint64_t>(duplicates, duplicates_.capacity()),
                              std::max<uint64_t>(pairs, pair_keys_.capacity()));
   }
@@ -527,8 +550,8 @@ std::unique_ptr<detect::Backend> make_cuda_backend(int device) {
   const int count = cuda_device_count();
   if (count == 0) throw InternalError("no CUDA device is usable here (no GPU, or no driver)");
   if (device < 0 || device >= count)
-    throw InternalError("--device " + std::to_string(device) + ": there are " + std::to_string(count) +
-                     " CUDA device(s), numbered from 0");
+    throw InternalError("--device " + std::to_string(device) + ": there are " +
+                        std::to_string(count) + " CUDA device(s), numbered from 0");
   return std::make_unique<CudaBackendImpl>(device);
 }
 

@@ -10,7 +10,8 @@
 
 namespace snag::cuda {
 
-[[noreturn]] inline void throw_cuda_error(cudaError_t status, const char* what, const char* file, int line) {
+[[noreturn]] inline void throw_cuda_error(cudaError_t status, const char* what, const char* file,
+                                          int line) {
   throw InternalError(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
                       cudaGetErrorName(status) + ": " + cudaGetErrorString(status));
 }
@@ -18,10 +19,10 @@ namespace snag::cuda {
 }  // namespace snag::cuda
 
 /// Throws snag::InternalError when `expr` (a CUDA runtime call) does not return cudaSuccess.
-#define SNAG_CUDA_CHECK(expr)                                                     \
-  do {                                                                            \
-    const cudaError_t snag_cuda_status_ = (expr);                                 \
-    if (snag_cuda_status_ != cudaSuccess)                                         \
+#define SNAG_CUDA_CHECK(expr)                                                       \
+  do {                                                                              \
+    const cudaError_t snag_cuda_status_ = (expr);                                   \
+    if (snag_cuda_status_ != cudaSuccess)                                           \
       ::snag::cuda::throw_cuda_error(snag_cuda_status_, #expr, __FILE__, __LINE__); \
   } while (0)
 

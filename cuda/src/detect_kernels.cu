@@ -15,11 +15,12 @@ namespace cg = cooperative_groups;
 
 /// Appends `value` at the next slot of `array`: one atomic per group of converged threads
 /// (warp-aggregated), not one per result. Past `capacity` only the counter moves.
-__device__ __forceinline__ void append(uint64_t* array, unsigned long long capacity, unsigned long long* counter,
-                                       uint64_t value) {
+__device__ __forceinline__ void append(uint64_t* array, unsigned long long capacity,
+                                       unsigned long long* counter, uint64_t value) {
   const cg::coalesced_group group = cg::coalesced_threads();
   unsigned long long base = 0;
-  if (group.thread_rank() == 0) base = atomicAdd(counter, static_cast<unsigned long long>(group.size()));
+  if (group.thread_rank() == 0)
+    base = atomicAdd(counter, static_cast<unsigned long long>(group.size()));
   base = group.shfl(base, 0);
   const unsigned long long at = base + group.thread_rank();
   if (at < capacity) array[at] = value;
@@ -38,26 +39,31 @@ struct DeviceSink {
 
   __device__ void hit(int32_t edge, int32_t triangle) {
     append(out.hits, out.hit_capacity, &out.counters->hits, pack(edge, triangle));
-    expanded += static_cast<unsigned long long>(out.edge_face_offsets[edge + 1] - out.edge_face_offsets[edge]);
+    expanded += static_cast<unsigned long long>(out.edge_face_offsets[edge + 1] -
+                                                out.edge_face_offsets[edge]);
   }
   __device__ void uncertain(int32_t edge, int32_t triangle) {
     append(out.uncertain, out.uncertain_capacity, &out.counters->uncertain, pack(edge, triangle));
   }
   __device__ void miss() { ++misses; }
   __device__ void duplicate(int32_t a, int32_t b) {
-    append(out.duplicates, out.duplicate_capacity, &out.counters->duplicates, pack(min(a, b), max(a, b)));
+    append(out.duplicates, out.duplicate_capacity, &out.counters->duplicates,
+           pack(min(a, b), max(a, b)));
   }
 };
 
 /// Adds each thread's value into *total: a warp sum, then one atomic per warp. Every thread of
 /// the block must call it.
-__device__ __forceinline__ void add_warp_total(unsigned long long value, unsigned long long* total) {
-  for (int offset = 16; offset > 0; offset >>= 1) value += __shfl_down_sync(0xffffffffu, value, offset);
+__device__ __forceinline__ void add_warp_total(unsigned long long value,
+                                               unsigned long long* total) {
+  for (int offset = 16; offset > 0; offset >>= 1)
+    value += __shfl_down_sync(0xffffffffu, value, offset);
   if ((threadIdx.x & 31) == 0 && value) atomicAdd(total, value);
 }
 
-__global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
-                                       int32_t* degenerate, int32_t* uncertain, FrameCounters* counters) {
+__global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles,
+                                       int32_t n, int32_t* degenerate, int32_t* uncertain,
+                                       FrameCounters* counters) {
   const int32_t t = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (t >= n) return;
   const geom::FilteredPredicates pred{positions};
@@ -65,7 +71,8 @@ __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom:
   const geom::Answer answer = geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]);
   // Rare: a plain atomic per id.
   if (answer == geom::Answer::yes) degenerate[atomicAdd(&counters->degenerate, 1ull)] = t;
-  if (answer == geom::Answer::uncertain) uncertain[atomicAdd(&counters->degenerate_uncertain, 1ull)] = t;
+  if (answer == geom::Answer::uncertain)
+    uncertain[atomicAdd(&counters->degenerate_uncertain, 1ull)] = t;
 }
 
 __global__ void flag_degenerate_kernel(const int32_t* list, int32_t count, uint8_t* degenerate) {
@@ -80,9 +87,10 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
 }
 
 /// One thread's share of the neighbour pass: listed pair i (their boxes always overlap).
-__device__ __forceinline__ void neighbor_pair(const PairInputs& in, const std::array<int32_t, 2>* pairs,
-                                              const uint8_t* shared_masks, int64_t i, DeviceSink& sink,
-                                              unsigned long long& candidates) {
+__device__ __forceinline__ void neighbor_pair(const PairInputs& in,
+                                              const std::array<int32_t, 2>* pairs,
+                                              const uint8_t* shared_masks, int64_t i,
+                                              DeviceSink& sink, unsigned long long& candidates) {
   const int32_t t = pairs[i][0], x = pairs[i][1];
   if (in.degenerate[t] || in.degenerate[x]) return;
   ++candidates;
@@ -92,8 +100,9 @@ __device__ __forceinline__ void neighbor_pair(const PairInputs& in, const std::a
 
 /// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
 /// neighbours and follow nearly the same path; pairs of the neighbour list are skipped.
-__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const PairInputs& in, int32_t position,
-                                              DeviceSink& sink, unsigned long long& candidates) {
+__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const PairInputs& in,
+                                              int32_t position, DeviceSink& sink,
+                                              unsigned long long& candidates) {
   const int32_t t = tree.triangle_at[position];
   if (in.degenerate[t]) return;
   const geom::Tri tt = in.topology.triangles[t];
@@ -109,11 +118,10 @@ __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const P
 
 /// Blocks [0, traverse_blocks) traverse, the rest run the neighbour pass (the branch is uniform
 /// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
-__global__ void __launch_bounds__(kNarrowBlock) narrow_phase_kernel(bvh::TreeView tree, PairInputs in,
-                                                                    const std::array<int32_t, 2>* pairs,
-                                                                    const uint8_t* shared_masks, int64_t pair_count,
-                                                                    unsigned traverse_blocks,
-                                                                    ResultBuffers out) {
+__global__ void __launch_bounds__(kNarrowBlock)
+    narrow_phase_kernel(bvh::TreeView tree, PairInputs in, const std::array<int32_t, 2>* pairs,
+                        const uint8_t* shared_masks, int64_t pair_count, unsigned traverse_blocks,
+                        ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
   if (blockIdx.x < traverse_blocks) {
@@ -130,10 +138,12 @@ __global__ void __launch_bounds__(kNarrowBlock) narrow_phase_kernel(bvh::TreeVie
 
 /// Adds pair `key` to the set; the thread that inserts it classifies it and appends it.
 __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::Vec3d* positions,
-                                            const geom::Tri* triangles, const PairSet& set, FrameCounters* counters) {
+                                            const geom::Tri* triangles, const PairSet& set,
+                                            FrameCounters* counters) {
   unsigned long long slot = (key * 0x9E3779B97F4A7C15ull) >> 20 & set.table_mask;
   for (;;) {
-    const unsigned long long was = atomicCAS(set.table + slot, kEmptyKey, static_cast<unsigned long long>(key));
+    const unsigned long long was =
+        atomicCAS(set.table + slot, kEmptyKey, static_cast<unsigned long long>(key));
     if (was == key) return;  // another thread has it
     if (was == kEmptyKey) break;
     slot = (slot + 1) & set.table_mask;
@@ -146,15 +156,18 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
   const geom::Answer crossing = geom::is_crossing(pred, triangles[a], triangles[b]);
   set.keys[at] = key;
   // bit 0: touching (PairKind's value), bit 1: certain
-  set.status[at] =
-      crossing == geom::Answer::uncertain ? uint8_t{1} : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
+  set.status[at] = crossing == geom::Answer::uncertain
+                       ? uint8_t{1}
+                       : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
 }
 
-__global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
-                              unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* offsets,
-                              const int32_t* faces, const uint8_t* degenerate, int bits,
-                              const geom::Vec3d* positions, const geom::Tri* triangles, PairSet set) {
-  const unsigned long long i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+__global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capacity,
+                              const uint64_t* duplicates, unsigned long long duplicate_capacity,
+                              FrameCounters* counters, const int32_t* offsets, const int32_t* faces,
+                              const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
+                              const geom::Tri* triangles, PairSet set) {
+  const unsigned long long i =
+      static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   // Past a capacity the narrow phase counted without storing: the host runs the frame again.
   const unsigned long long hit_count = min(counters->hits, hit_capacity);
   const unsigned long long duplicate_count = min(counters->duplicates, duplicate_capacity);
@@ -165,7 +178,8 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
     for (int32_t j = offsets[edge]; j < offsets[edge + 1]; ++j) {
       const int32_t face = faces[j];
       if (face == triangle || degenerate[face]) continue;
-      const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) | static_cast<uint64_t>(max(face, triangle));
+      const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) |
+                           static_cast<uint64_t>(max(face, triangle));
       insert_pair(key, bits, positions, triangles, set, counters);
     }
   } else if (i - hit_capacity < duplicate_count) {
@@ -178,16 +192,17 @@ using FinishPairSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItem
 using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItems>;
 
 /// Shared memory of finish_kernel: more than the static 48 KB, so it is dynamic.
-constexpr size_t kFinishShared = sizeof(typename FinishPairSort::TempStorage) > sizeof(typename FinishTaskSort::TempStorage)
+constexpr size_t kFinishShared = sizeof(typename FinishPairSort::TempStorage) >
+                                         sizeof(typename FinishTaskSort::TempStorage)
                                      ? sizeof(typename FinishPairSort::TempStorage)
                                      : sizeof(typename FinishTaskSort::TempStorage);
 
 /// The frame's results to host memory: small sets sorted in shared memory (keys are distinct,
 /// so the order is total and the block's output is the device-wide sort's), the counters last.
-__global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCounters* counters, PairSet set,
-                                                                const uint64_t* uncertain,
-                                                                unsigned long long uncertain_capacity, int key_bits,
-                                                                int task_bits, HostResults out) {
+__global__ void __launch_bounds__(kFinishThreads)
+    finish_kernel(const FrameCounters* counters, PairSet set, const uint64_t* uncertain,
+                  unsigned long long uncertain_capacity, int key_bits, int task_bits,
+                  HostResults out) {
   extern __shared__ __align__(16) unsigned char shared[];
   const FrameCounters c = *counters;
   const unsigned long long limit = min(out.limit, kFinishLimit);
@@ -202,7 +217,8 @@ __global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCount
     FinishPairSort(*reinterpret_cast<typename FinishPairSort::TempStorage*>(shared))
         .SortBlockedToStriped(keys, status, 0, key_bits);
     for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+      const unsigned long long at =
+          static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
       if (at < c.pairs) {
         out.keys[at] = keys[k];
         out.status[at] = status[k];
@@ -219,7 +235,8 @@ __global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCount
     FinishTaskSort(*reinterpret_cast<typename FinishTaskSort::TempStorage*>(shared))
         .SortBlockedToStriped(keys, 0, task_bits);
     for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+      const unsigned long long at =
+          static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
       if (at < c.uncertain) out.uncertain[at] = keys[k];
     }
   }
@@ -228,40 +245,45 @@ __global__ void __launch_bounds__(kFinishThreads) finish_kernel(const FrameCount
 
 }  // namespace
 
-void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, int32_t* degenerate,
-                            int32_t* uncertain, FrameCounters* counters, cudaStream_t stream) {
-  launch(scan_degenerate_kernel, n, stream, positions, triangles, n, degenerate, uncertain, counters);
+void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
+                            int32_t* degenerate, int32_t* uncertain, FrameCounters* counters,
+                            cudaStream_t stream) {
+  launch(scan_degenerate_kernel, n, stream, positions, triangles, n, degenerate, uncertain,
+         counters);
 }
 
-void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate, cudaStream_t stream) {
+void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
+                            cudaStream_t stream) {
   launch(flag_degenerate_kernel, count, stream, list, count, degenerate);
 }
 
-void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, geom::PlaneCoefficients* planes,
-                   cudaStream_t stream) {
+void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
+                   geom::PlaneCoefficients* planes, cudaStream_t stream) {
   launch(planes_kernel, n, stream, positions, triangles, n, planes);
 }
 
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs, const uint8_t* neighbor_shared,
-                         int64_t neighbor_pair_count,
+                         const std::array<int32_t, 2>* neighbor_pairs,
+                         const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream) {
   const int64_t traverse_blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
   const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
   if (blocks == 0) return;
   narrow_phase_kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
-      tree, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count, static_cast<unsigned>(traverse_blocks),
-      results);
+      tree, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count,
+      static_cast<unsigned>(traverse_blocks), results);
   SNAG_CUDA_CHECK_LAUNCH();
 }
 
-void launch_expand(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
-                   unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* edge_face_offsets,
-                   const int32_t* edge_faces, const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
-                   const geom::Tri* triangles, const PairSet& set, cudaStream_t stream) {
-  launch(expand_kernel, static_cast<int64_t>(hit_capacity + duplicate_capacity), stream, hits, hit_capacity,
-         duplicates, duplicate_capacity, counters, edge_face_offsets, edge_faces, degenerate, bits, positions,
-         triangles, set);
+void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
+                   const uint64_t* duplicates, unsigned long long duplicate_capacity,
+                   FrameCounters* counters, const int32_t* edge_face_offsets,
+                   const int32_t* edge_faces, const uint8_t* degenerate, int bits,
+                   const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
+                   cudaStream_t stream) {
+  launch(expand_kernel, static_cast<int64_t>(hit_capacity + duplicate_capacity), stream, hits,
+         hit_capacity, duplicates, duplicate_capacity, counters, edge_face_offsets, edge_faces,
+         degenerate, bits, positions, triangles, set);
 }
 
 void configure_kernels() {
@@ -270,10 +292,10 @@ void configure_kernels() {
 }
 
 void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
-                   unsigned long long uncertain_capacity, int key_bits, int task_bits, const HostResults& out,
-                   cudaStream_t stream) {
-  finish_kernel<<<1, kFinishThreads, kFinishShared, stream>>>(counters, set, uncertain, uncertain_capacity, key_bits,
-                                                             task_bits, out);
+                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
+                   const HostResults& out, cudaStream_t stream) {
+  finish_kernel<<<1, kFinishThreads, kFinishShared, stream>>>(
+      counters, set, uncertain, uncertain_capacity, key_bits, task_bits, out);
   SNAG_CUDA_CHECK_LAUNCH();
 }
 

@@ -26,7 +26,7 @@ struct FrameCounters {
   unsigned long long expanded;    ///< sum over hits of the edge's face count: a bound on pairs
   unsigned long long degenerate;  ///< scan: certainly degenerate triangles
   unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
-  unsigned long long pairs;       ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
+  unsigned long long pairs;  ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
 };
 
 /// The pairs of a frame as the expansion leaves them: distinct (a << bits | b) keys, a < b, in
@@ -84,23 +84,25 @@ void configure_kernels();
 
 /// Degenerate-triangle scan: appends ids the filter finds degenerate to `degenerate` and ids it
 /// cannot decide to `uncertain` (both in any order), counting them in counters.
-void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, int32_t* degenerate,
-                            int32_t* uncertain, FrameCounters* counters, cudaStream_t stream);
+void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
+                            int32_t* degenerate, int32_t* uncertain, FrameCounters* counters,
+                            cudaStream_t stream);
 
 /// Sets degenerate[list[i]] = 1.
-void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate, cudaStream_t stream);
+void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
+                            cudaStream_t stream);
 
 /// planes[t] = the plane of triangle t (detect::triangle_plane). The refit computes them too; this
 /// is for frames whose tree was not refit to the current positions.
-void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n, geom::PlaneCoefficients* planes,
-                   cudaStream_t stream);
+void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
+                   geom::PlaneCoefficients* planes, cudaStream_t stream);
 
 /// The candidate pairs of the traversal (one thread per leaf position, in leaf order) and those
 /// of the neighbour list (one thread per pair), each through detect::test_candidate_pair: one
 /// launch, the traversal's blocks first (they run longest).
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs, const uint8_t* neighbor_shared,
-                         int64_t neighbor_pair_count,
+                         const std::array<int32_t, 2>* neighbor_pairs,
+                         const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
                          const ResultBuffers& results, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
@@ -108,16 +110,18 @@ void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
 /// the double filter (detect::is_crossing) once each. Reads the counts from `counters` (the
 /// narrow phase's), so it can be queued before they are known: the grid covers the buffers'
 /// capacities, and entries past a count or past a capacity are not read.
-void launch_expand(const uint64_t* hits, unsigned long long hit_capacity, const uint64_t* duplicates,
-                   unsigned long long duplicate_capacity, FrameCounters* counters, const int32_t* edge_face_offsets,
-                   const int32_t* edge_faces, const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
-                   const geom::Tri* triangles, const PairSet& set, cudaStream_t stream);
+void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
+                   const uint64_t* duplicates, unsigned long long duplicate_capacity,
+                   FrameCounters* counters, const int32_t* edge_face_offsets,
+                   const int32_t* edge_faces, const uint8_t* degenerate, int bits,
+                   const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
+                   cudaStream_t stream);
 
 /// One block: when the frame's pairs and uncertain tests each fit in the block (and in
 /// out.limit), sorts them (pairs by key over key_bits, uncertain tests by (edge, triangle) over
 /// task_bits) and writes them to `out`; always copies the counters to out.counters.
 void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
-                   unsigned long long uncertain_capacity, int key_bits, int task_bits, const HostResults& out,
-                   cudaStream_t stream);
+                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
+                   const HostResults& out, cudaStream_t stream);
 
 }  // namespace snag::cuda

@@ -26,12 +26,14 @@ __device__ __forceinline__ uint64_t order_key(double x) {
 
 /// The centroid times three (the CPU's sum of corners, same order of additions) and, per axis,
 /// the sort key of its coordinate with the triangle id beside it.
-__global__ void centroid_keys_kernel(mesh::MeshView mesh, geom::Vec3d* centroids, uint64_t* keys, int32_t* ids) {
+__global__ void centroid_keys_kernel(mesh::MeshView mesh, geom::Vec3d* centroids, uint64_t* keys,
+                                     int32_t* ids) {
   const int32_t n = mesh.triangle_count;
   const int32_t t = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (t >= n) return;
   const geom::Tri tri = mesh.triangles[t];
-  const geom::Vec3d c = mesh.positions[tri.v[0]] + mesh.positions[tri.v[1]] + mesh.positions[tri.v[2]];
+  const geom::Vec3d c =
+      mesh.positions[tri.v[0]] + mesh.positions[tri.v[1]] + mesh.positions[tri.v[2]];
   centroids[t] = c;
   for (int k = 0; k < 3; ++k) {
     keys[static_cast<size_t>(k) * n + t] = order_key(geom::coord(c, k));
@@ -41,15 +43,16 @@ __global__ void centroid_keys_kernel(mesh::MeshView mesh, geom::Vec3d* centroids
 
 /// The node of `level` whose leaf range holds position p. Position p is level-D slot p when
 /// p < m, else a level-(D - 1) leaf standing for slots 2p - m and 2p - m + 1 (complete_tree.h).
-__device__ __forceinline__ int32_t node_at_level(const CompleteTree& shape, int32_t p, int32_t level) {
+__device__ __forceinline__ int32_t node_at_level(const CompleteTree& shape, int32_t p,
+                                                 int32_t level) {
   const int32_t slot = p < shape.deepest_leaves ? p : 2 * p - shape.deepest_leaves;
   return CompleteTree::level_begin(level) + (slot >> (shape.depth - level));
 }
 
 /// The segment [begin, end) of position p at `level` and where it splits; a leaf (its segment
 /// is one position) splits at its end, so that nothing moves.
-__device__ __forceinline__ void segment_of(const CompleteTree& shape, int32_t p, int32_t level, int32_t& begin,
-                                           int32_t& end, int32_t& split) {
+__device__ __forceinline__ void segment_of(const CompleteTree& shape, int32_t p, int32_t level,
+                                           int32_t& begin, int32_t& end, int32_t& split) {
   const int32_t node = node_at_level(shape, p, level);
   if (shape.is_leaf(node)) {
     begin = p;
@@ -79,7 +82,8 @@ __global__ void mark_left_kernel(CompleteTree shape, int32_t level, const geom::
     const int32_t* list = lists + static_cast<size_t>(k) * n;
     extent[k] = geom::coord(centroids[list[end - 1]], k) - geom::coord(centroids[list[begin]], k);
   }
-  const int axis = (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
+  const int axis =
+      (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
   left[lists[static_cast<size_t>(axis) * n + p]] = p < split ? 1 : 0;
 }
 
@@ -89,12 +93,13 @@ struct LeftMark {
 };
 
 /// One thread per entry of the three lists: the stable partition of its segment by the marks.
-__global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_t* lists, const uint8_t* left,
-                                 const int32_t* scan, int32_t* out) {
+__global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_t* lists,
+                                 const uint8_t* left, const int32_t* scan, int32_t* out) {
   const int32_t n = shape.leaf_count;
   const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= 3 * static_cast<int64_t>(n)) return;
-  const int32_t k = static_cast<int32_t>(i / n), p = static_cast<int32_t>(i - static_cast<int64_t>(k) * n);
+  const int32_t k = static_cast<int32_t>(i / n),
+                p = static_cast<int32_t>(i - static_cast<int64_t>(k) * n);
   const size_t base = static_cast<size_t>(k) * n;
   int32_t begin, end, split;
   segment_of(shape, p, level, begin, end, split);
@@ -106,8 +111,10 @@ __global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_
 
 /// The leaf at position p fit to its triangle, whose plane the narrow phase reads (computed
 /// here, where the corners are loaded anyway, instead of in a launch of its own).
-__device__ __forceinline__ int32_t refit_leaf_and_plane(const bvh::TreeView& tree, const mesh::MeshView& mesh,
-                                                        geom::PlaneCoefficients* planes, int32_t p) {
+__device__ __forceinline__ int32_t refit_leaf_and_plane(const bvh::TreeView& tree,
+                                                        const mesh::MeshView& mesh,
+                                                        geom::PlaneCoefficients* planes,
+                                                        int32_t p) {
   const int32_t leaf = tree.shape.leaf_at(p);
   bvh::refit_leaf(leaf, tree, mesh);
   const int32_t t = tree.triangle_at[p];
@@ -115,7 +122,8 @@ __device__ __forceinline__ int32_t refit_leaf_and_plane(const bvh::TreeView& tre
   return leaf;
 }
 
-__global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes) {
+__global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh,
+                                    geom::PlaneCoefficients* planes) {
   const int32_t n = tree.shape.leaf_count;
   const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (p < n) refit_leaf_and_plane(tree, mesh, planes, p);
@@ -131,8 +139,8 @@ __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t la
 /// sibling's box complete: the sibling's writer made its box visible (__threadfence) before
 /// its atomicAdd, and the box is read from L2 (__ldcg), past a possibly stale L1 line. The
 /// second arrival resets the counter, so every counter is zero again after the launch.
-__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
-                                   uint32_t* counters) {
+__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh,
+                                   geom::PlaneCoefficients* planes, uint32_t* counters) {
   const int32_t n = tree.shape.leaf_count;
   const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (p >= n) return;
@@ -159,9 +167,9 @@ __global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom
 /// sequential additions, so the same bits), reading shared memory instead of waiting on a
 /// global load per node (that wait made it 0.26 ms at 36K, 3 ms at 1M). The last block to
 /// finish adds the block sums in order (bvh::quality_from_blocks) and resets the ticket.
-__global__ void __launch_bounds__(kQualityThreads) quality_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape,
-                                                                  int32_t blocks, double* block_sums,
-                                                                  unsigned* ticket, double* out) {
+__global__ void __launch_bounds__(kQualityThreads)
+    quality_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape, int32_t blocks,
+                   double* block_sums, unsigned* ticket, double* out) {
   __shared__ double areas[bvh::kQualityBlock];
   __shared__ bool last;
   const int32_t block = static_cast<int32_t>(blockIdx.x);
@@ -211,8 +219,8 @@ void DeviceTree::resize(int32_t n) {
   quality_blocks_.reserve(static_cast<size_t>((n + bvh::kQualityBlock - 1) / bvh::kQualityBlock));
   // Scratch for the sorts and the scans, sized for the largest of them.
   size_t sort_bytes = 0, scan_bytes = 0;
-  SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys_.data(), keys_alt_.data(), ids_.data(),
-                                                  lists_.data(), n));
+  SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys_.data(),
+                                                  keys_alt_.data(), ids_.data(), lists_.data(), n));
   auto marks = thrust::make_transform_iterator(lists_.data(), LeftMark{left_.data()});
   SNAG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scan_bytes, marks, scan_.data(), 3 * n));
   temp_.reserve(std::max(sort_bytes, scan_bytes));
@@ -228,17 +236,19 @@ void DeviceTree::build(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cud
   for (int k = 0; k < 3; ++k) {
     // Stable: equal coordinates keep the ids' increasing order, the CPU's tie-break.
     size_t bytes = temp_.capacity();
-    SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp_.data(), bytes, keys_.data() + k * count,
-                                                    keys_alt_.data() + k * count, ids_.data() + k * count,
-                                                    lists_.data() + k * count, n, 0, 64, stream));
+    SNAG_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(
+        temp_.data(), bytes, keys_.data() + k * count, keys_alt_.data() + k * count,
+        ids_.data() + k * count, lists_.data() + k * count, n, 0, 64, stream));
   }
   for (int32_t level = 0; level < shape_.depth; ++level) {
-    launch(mark_left_kernel, n, stream, shape_, level, centroids_.data(), lists_.data(), left_.data());
+    launch(mark_left_kernel, n, stream, shape_, level, centroids_.data(), lists_.data(),
+           left_.data());
     size_t bytes = temp_.capacity();
     auto marks = thrust::make_transform_iterator(lists_.data(), LeftMark{left_.data()});
-    SNAG_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, marks, scan_.data(), 3 * n, stream));
-    launch(partition_kernel, 3 * n, stream, shape_, level, lists_.data(), left_.data(), scan_.data(),
-           lists_alt_.data());
+    SNAG_CUDA_CHECK(
+        cub::DeviceScan::ExclusiveSum(temp_.data(), bytes, marks, scan_.data(), 3 * n, stream));
+    launch(partition_kernel, 3 * n, stream, shape_, level, lists_.data(), left_.data(),
+           scan_.data(), lists_alt_.data());
     lists_.swap(lists_alt_);
   }
   // Every list holds the leaf order now; the first one becomes the permutation.

@@ -72,7 +72,7 @@ class DeviceTree {
   DeviceBuffer<unsigned char> temp_;
   DeviceBuffer<double> quality_blocks_;  // one sum per bvh::kQualityBlock internal nodes
   PinnedBuffer<double> quality_host_;
-  double* quality_out_ = nullptr;       // quality_host_'s device address
+  double* quality_out_ = nullptr;          // quality_host_'s device address
   DeviceBuffer<unsigned> quality_ticket_;  // blocks done; the last one resets it
   int32_t capacity_ = 0;
 };

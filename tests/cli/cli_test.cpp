@@ -212,7 +212,8 @@ TEST(CliStatus, CudaBackendRunsOrExitsFourWithAReason) {
   } else {
     EXPECT_EQ(r.status, 1) << context(r);  // a GPU is here: the sequence has a crossing
   }
-  const RunResult bad = run_snag({"check", "seq", "--backend", "cuda", "--device", "999"}, tmp.path());
+  const RunResult bad =
+      run_snag({"check", "seq", "--backend", "cuda", "--device", "999"}, tmp.path());
   EXPECT_EQ(bad.status, 4) << context(bad);
   EXPECT_FALSE(bad.err.empty());
 }

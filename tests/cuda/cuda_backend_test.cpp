@@ -20,8 +20,8 @@
 namespace snag::test {
 namespace {
 
-#define SNAG_REQUIRE_GPU()                                                               \
-  do {                                                                                   \
+#define SNAG_REQUIRE_GPU()                                                                  \
+  do {                                                                                      \
     if (cuda::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device: GPU test skipped"; \
   } while (0)
 
@@ -44,8 +44,10 @@ Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positio
   Filtered f;
   backend.set_positions(positions);
   f.scan = backend.scan_degenerate();
-  if (build) backend.build();
-  else backend.refit();
+  if (build)
+    backend.build();
+  else
+    backend.refit();
   f.quality = backend.tree_quality();
   f.frame = backend.detect(f.scan.degenerate);
   return f;
@@ -64,7 +66,8 @@ void expect_same(const Filtered& cpu, const Filtered& gpu, const std::string& wh
 
 /// Both backends on one mesh, one frame, from a fresh build.
 void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_t capacity = 0) {
-  const detect::Topology topology = detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  const detect::Topology topology =
+      detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   auto cpu = detect::make_cpu_backend(2);
   auto gpu = gpu_backend();
   if (capacity > 0) gpu->set_result_capacity(capacity);
@@ -86,7 +89,8 @@ SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
   SmallMesh soup;
   for (int32_t t = 0; t < n; ++t) {
     const geom::Vec3d c{where(rng), where(rng), where(rng)};
-    for (int k = 0; k < 3; ++k) soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
+    for (int k = 0; k < 3; ++k)
+      soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
     soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
   }
   return soup;
@@ -97,26 +101,31 @@ TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
   auto gpu = gpu_backend();
   std::vector<int32_t> sizes;
   for (int32_t n = 1; n <= 300; ++n) sizes.push_back(n);
-  for (int32_t n : {511, 512, 513, 1000, 1023, 1024, 1025, 4097, 10000, 65537, 200000}) sizes.push_back(n);
+  for (int32_t n : {511, 512, 513, 1000, 1023, 1024, 1025, 4097, 10000, 65537, 200000})
+    sizes.push_back(n);
   for (int32_t n : sizes) {
     const uint32_t seed = 7000 + static_cast<uint32_t>(n);
     // Coarse coordinates: many equal centroid coordinates, so ties are broken by id often.
     SmallMesh soup = random_soup(n, seed, 0.5);
     if (n % 3 == 0)
-      for (auto& p : soup.positions) p = {std::round(p.x), std::round(p.y * 2) / 2, std::round(p.z)};
+      for (auto& p : soup.positions)
+        p = {std::round(p.x), std::round(p.y * 2) / 2, std::round(p.z)};
     if (n % 5 == 0)
       for (auto& p : soup.positions) p.x = -p.x;  // negative coordinates, -0 among them
     const mesh::MeshView view = mesh::view_of(soup.positions, soup.triangles);
     bvh::Tree cpu_tree;
     cpu_tree.build(view, 2);
-    const detect::Topology topology = detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    const detect::Topology topology =
+        detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
     gpu->set_topology(topology);
     gpu->set_positions(soup.positions);
     gpu->build();
     ASSERT_EQ(gpu->triangle_order(), cpu_tree.triangle_at()) << "n=" << n << " seed=" << seed;
     const std::vector<geom::Box3f> boxes = gpu->node_boxes();
     ASSERT_EQ(boxes.size(), cpu_tree.boxes().size());
-    ASSERT_EQ(std::memcmp(boxes.data(), cpu_tree.boxes().data(), boxes.size() * sizeof(geom::Box3f)), 0) << "n=" << n;
+    ASSERT_EQ(
+        std::memcmp(boxes.data(), cpu_tree.boxes().data(), boxes.size() * sizeof(geom::Box3f)), 0)
+        << "n=" << n;
     ASSERT_EQ(gpu->tree_quality(), cpu_tree.quality()) << "n=" << n;
   }
 }
@@ -125,7 +134,8 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
   SNAG_REQUIRE_GPU();
   for (int32_t n : {1, 2, 3, 77, 1000, 33333}) {
     SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
-    const detect::Topology topology = detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    const detect::Topology topology =
+        detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
     bvh::Tree cpu_tree;
     cpu_tree.build(mesh::view_of(soup.positions, soup.triangles), 2);
     for (bool level_by_level : {false, true}) {
@@ -144,7 +154,9 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
         gpu->set_positions(moved.positions);
         gpu->refit();
         const std::vector<geom::Box3f> boxes = gpu->node_boxes();
-        ASSERT_EQ(std::memcmp(boxes.data(), cpu_copy.boxes().data(), boxes.size() * sizeof(geom::Box3f)), 0)
+        ASSERT_EQ(
+            std::memcmp(boxes.data(), cpu_copy.boxes().data(), boxes.size() * sizeof(geom::Box3f)),
+            0)
             << "n=" << n << " level_by_level=" << level_by_level << " frame " << frame;
       }
     }
@@ -154,8 +166,9 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
 TEST(CudaDetect, HandBuiltCasesMatchTheCpuAndTheExpectedPairs) {
   SNAG_REQUIRE_GPU();
   for (const Case& c : cases()) {
-    for (const auto& [m, offset] : {std::pair{&kIdentity, geom::Vec3d{0, 0, 0}}, std::pair{&kShear, geom::Vec3d{3, -5, 7}},
-                                    std::pair{&kMirror, geom::Vec3d{-1000, 77, 5}}}) {
+    for (const auto& [m, offset] :
+         {std::pair{&kIdentity, geom::Vec3d{0, 0, 0}}, std::pair{&kShear, geom::Vec3d{3, -5, 7}},
+          std::pair{&kMirror, geom::Vec3d{-1000, 77, 5}}}) {
       const SmallMesh mesh = transformed(c.mesh, *m, offset);
       expect_same_filtered(mesh, c.name);
       const detect::FrameResult result = check_on_gpu(mesh);
@@ -169,7 +182,8 @@ TEST(CudaDetect, LatticeSoupsMatchTheCpuAndBruteForce) {
   SNAG_REQUIRE_GPU();
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     const int32_t n = 20 + static_cast<int32_t>(seed * 7 % 90);
-    const SmallMesh mesh = lattice_soup(n, n + static_cast<int32_t>(seed % 3) * n, 3 + static_cast<int>(seed % 5), seed);
+    const SmallMesh mesh = lattice_soup(n, n + static_cast<int32_t>(seed % 3) * n,
+                                        3 + static_cast<int>(seed % 5), seed);
     expect_same_filtered(mesh, "seed " + std::to_string(seed));
     ASSERT_EQ(check_on_gpu(mesh).pairs, brute_force(mesh)) << "seed " << seed;
     ASSERT_EQ(check_on_gpu(mesh).pairs, check_mesh(mesh, 2).pairs) << "seed " << seed;
@@ -191,7 +205,8 @@ TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
   SNAG_REQUIRE_GPU();
   // A folded grid has hundreds of hits and uncertain tests; buffers of 1 and 7 entries must grow.
   const SmallMesh mesh = folded_grid(30, 20);
-  for (int64_t capacity : {1, 7, 100}) expect_same_filtered(mesh, "capacity " + std::to_string(capacity), capacity);
+  for (int64_t capacity : {1, 7, 100})
+    expect_same_filtered(mesh, "capacity " + std::to_string(capacity), capacity);
   // Overlapping coplanar copies: every pair intersects, 44,850 pairs from a 1-entry start.
   SmallMesh stack;
   for (int i = 0; i < 300; ++i) {
@@ -234,7 +249,8 @@ TEST(CudaDetect, RefitMatchesRebuildTheCpuAndBruteForceAfterDeformation) {
     EXPECT_EQ(a.filtered_tests, c.filtered_tests) << "frame " << frame;
     EXPECT_EQ(a.uncertain_tests, c.uncertain_tests) << "frame " << frame;
     EXPECT_EQ(a.tree_quality, c.tree_quality) << "frame " << frame;
-    for (auto& p : mesh.positions) p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+    for (auto& p : mesh.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
   }
 }
 
@@ -243,7 +259,8 @@ TEST(CudaDetect, DegenerateFacesComeAndGoBetweenFrames) {
   // Frames that flatten some triangles to zero area and restore them: ownership moves to the
   // next incident face and back, and the device flags must follow.
   SmallMesh mesh = folded_grid(12, 8);
-  const detect::Topology topology = detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  const detect::Topology topology =
+      detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   auto cpu = detect::make_cpu_backend(2);
   auto gpu = gpu_backend();
   cpu->set_topology(topology);
@@ -304,7 +321,8 @@ TEST(CudaBackend, ResidentFramesGiveTheSameResultsAsUploadedOnes) {
   SNAG_REQUIRE_GPU();
   SmallMesh a = folded_grid(20, 10), b = a;
   for (auto& p : b.positions) p = p + geom::Vec3d{0, 0, std::fmod(p.x * 7, 3.0)};
-  const detect::Topology topology = detect::make_topology(a.triangles, static_cast<int32_t>(a.positions.size()));
+  const detect::Topology topology =
+      detect::make_topology(a.triangles, static_cast<int32_t>(a.positions.size()));
   auto uploaded = gpu_backend(), resident = gpu_backend();
   uploaded->set_topology(topology);
   resident->set_topology(topology);

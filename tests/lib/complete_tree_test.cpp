@@ -64,7 +64,8 @@ Soup random_soup(int32_t count, uint32_t seed, double size) {
   Soup soup;
   for (int32_t t = 0; t < count; ++t) {
     const geom::Vec3d c{where(rng), where(rng), where(rng)};
-    for (int k = 0; k < 3; ++k) soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
+    for (int k = 0; k < 3; ++k)
+      soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
     soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
   }
   return soup;
@@ -132,14 +133,16 @@ TEST(Tree, BuildSplitsEachSegmentAlongTheLongestAxis) {
   Tree tree;
   tree.build(soup.view(), 2);
   for (int32_t p = 1; p < n; ++p)
-    ASSERT_LT(soup.positions[3 * tree.triangle_at()[p - 1]].x, soup.positions[3 * tree.triangle_at()[p]].x);
+    ASSERT_LT(soup.positions[3 * tree.triangle_at()[p - 1]].x,
+              soup.positions[3 * tree.triangle_at()[p]].x);
 }
 
 TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   for (int32_t n : {1, 2, 3, 9, 50, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {
       const uint32_t seed = static_cast<uint32_t>(n * 31 + size * 7);
-      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) + " seed=" + std::to_string(seed));
+      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
+                   " seed=" + std::to_string(seed));
       Soup soup = random_soup(n, seed, size);
       Tree tree;
       tree.build(soup.view(), 2);
@@ -147,14 +150,18 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
       std::multiset<std::pair<int32_t, int32_t>> visited;
       for (int32_t p = 0; p < n; ++p) {
         const int32_t t = view.triangle_at[p];
-        for_each_later_overlap(view, p, [&](int32_t x) { visited.insert({std::min(t, x), std::max(t, x)}); });
+        for_each_later_overlap(view, p, [&](int32_t x) {
+          visited.insert({std::min(t, x), std::max(t, x)});
+        });
       }
       std::multiset<std::pair<int32_t, int32_t>> expected;
       for (int32_t a = 0; a < n; ++a)
         for (int32_t b = a + 1; b < n; ++b) {
           const geom::Tri ta = soup.triangles[a], tb = soup.triangles[b];
-          const geom::Box3f boxa = geom::triangle_box(soup.positions[ta.v[0]], soup.positions[ta.v[1]], soup.positions[ta.v[2]]);
-          const geom::Box3f boxb = geom::triangle_box(soup.positions[tb.v[0]], soup.positions[tb.v[1]], soup.positions[tb.v[2]]);
+          const geom::Box3f boxa = geom::triangle_box(
+              soup.positions[ta.v[0]], soup.positions[ta.v[1]], soup.positions[ta.v[2]]);
+          const geom::Box3f boxb = geom::triangle_box(
+              soup.positions[tb.v[0]], soup.positions[tb.v[1]], soup.positions[tb.v[2]]);
           if (geom::overlap(boxa, boxb)) expected.insert({a, b});
         }
       ASSERT_EQ(visited, expected);
@@ -166,7 +173,8 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
   for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 100, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {
       const uint32_t seed = static_cast<uint32_t>(n * 17 + size * 3);
-      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) + " seed=" + std::to_string(seed));
+      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
+                   " seed=" + std::to_string(seed));
       Soup soup = random_soup(n, seed, size);
       Tree tree;
       tree.build(soup.view(), 2);
@@ -174,7 +182,9 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
       std::multiset<std::pair<int32_t, int32_t>> per_leaf, grouped;
       for (int32_t p = 0; p < n; ++p) {
         const int32_t t = view.triangle_at[p];
-        for_each_later_overlap(view, p, [&](int32_t x) { per_leaf.insert({std::min(t, x), std::max(t, x)}); });
+        for_each_later_overlap(view, p, [&](int32_t x) {
+          per_leaf.insert({std::min(t, x), std::max(t, x)});
+        });
       }
       const int32_t level = group_level(view.shape);
       const int32_t first = CompleteTree::level_begin(level);

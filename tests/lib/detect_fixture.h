@@ -28,7 +28,8 @@ inline detect::FrameResult check_mesh(const SmallMesh& mesh, int threads = 2,
 inline SmallMesh transformed(SmallMesh mesh, const int m[3][3], geom::Vec3d t) {
   for (auto& p : mesh.positions) {
     const geom::Vec3d q = p;
-    p = {m[0][0] * q.x + m[0][1] * q.y + m[0][2] * q.z + t.x, m[1][0] * q.x + m[1][1] * q.y + m[1][2] * q.z + t.y,
+    p = {m[0][0] * q.x + m[0][1] * q.y + m[0][2] * q.z + t.x,
+         m[1][0] * q.x + m[1][1] * q.y + m[1][2] * q.z + t.y,
          m[2][0] * q.x + m[2][1] * q.y + m[2][2] * q.z + t.z};
   }
   return mesh;

@@ -13,7 +13,8 @@ namespace {
 TEST(Detect, MatchesBruteForceOnLatticeSoups) {
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     const int32_t n = 20 + static_cast<int32_t>(seed * 7 % 90);
-    const SmallMesh mesh = lattice_soup(n, n + static_cast<int32_t>(seed % 3) * n, 3 + static_cast<int>(seed % 5), seed);
+    const SmallMesh mesh = lattice_soup(n, n + static_cast<int32_t>(seed % 3) * n,
+                                        3 + static_cast<int>(seed % 5), seed);
     const std::vector<detect::FacePair> expected = brute_force(mesh);
     for (int threads : {1, 2, 3}) {
       const detect::FrameResult result = check_mesh(mesh, threads);
@@ -35,7 +36,8 @@ TEST(Detect, RefitMatchesRebuildAndBruteForceAfterDeformation) {
   SmallMesh mesh = folded_grid(15, 10);
   auto resolver = std::make_shared<IntegerResolver>();
   detect::Checker refitting(detect::make_cpu_backend(2), resolver, {detect::RebuildPolicy::never});
-  detect::Checker rebuilding(detect::make_cpu_backend(2), resolver, {detect::RebuildPolicy::always});
+  detect::Checker rebuilding(detect::make_cpu_backend(2), resolver,
+                             {detect::RebuildPolicy::always});
   refitting.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   rebuilding.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   std::mt19937 rng(99);
@@ -47,7 +49,8 @@ TEST(Detect, RefitMatchesRebuildAndBruteForceAfterDeformation) {
     EXPECT_EQ(a.pairs, brute_force(mesh)) << "frame " << frame;
     EXPECT_EQ(a.rebuilt, frame == 0);
     EXPECT_TRUE(b.rebuilt);
-    for (auto& p : mesh.positions) p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+    for (auto& p : mesh.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
   }
   EXPECT_EQ(refitting.rebuild_count(), 0);
   EXPECT_EQ(rebuilding.rebuild_count(), 5);

@@ -15,16 +15,22 @@ struct IntegerPredicates {
   const geom::Vec3d* positions;
 
   static __int128 integer(double x) {
-    if (x != std::floor(x) || std::fabs(x) > 1048576.0) throw std::logic_error("IntegerPredicates: not a small integer");
+    if (x != std::floor(x) || std::fabs(x) > 1048576.0)
+      throw std::logic_error("IntegerPredicates: not a small integer");
     return static_cast<__int128>(x);
   }
-  static geom::Sign sign(__int128 v) { return v > 0 ? geom::Sign::positive : (v < 0 ? geom::Sign::negative : geom::Sign::zero); }
+  static geom::Sign sign(__int128 v) {
+    return v > 0 ? geom::Sign::positive : (v < 0 ? geom::Sign::negative : geom::Sign::zero);
+  }
 
   geom::Sign orient3d(int32_t a, int32_t b, int32_t c, int32_t d) const {
     const geom::Vec3d pa = positions[a], pb = positions[b], pc = positions[c], pd = positions[d];
-    const __int128 ux = integer(pb.x) - integer(pa.x), uy = integer(pb.y) - integer(pa.y), uz = integer(pb.z) - integer(pa.z);
-    const __int128 vx = integer(pc.x) - integer(pa.x), vy = integer(pc.y) - integer(pa.y), vz = integer(pc.z) - integer(pa.z);
-    const __int128 wx = integer(pd.x) - integer(pa.x), wy = integer(pd.y) - integer(pa.y), wz = integer(pd.z) - integer(pa.z);
+    const __int128 ux = integer(pb.x) - integer(pa.x), uy = integer(pb.y) - integer(pa.y),
+                   uz = integer(pb.z) - integer(pa.z);
+    const __int128 vx = integer(pc.x) - integer(pa.x), vy = integer(pc.y) - integer(pa.y),
+                   vz = integer(pc.z) - integer(pa.z);
+    const __int128 wx = integer(pd.x) - integer(pa.x), wy = integer(pd.y) - integer(pa.y),
+                   wz = integer(pd.z) - integer(pa.z);
     return sign(ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx));
   }
   geom::Sign orient2d(int32_t a, int32_t b, int32_t c, int axis) const {
@@ -38,14 +44,16 @@ struct IntegerPredicates {
   int dominant_axis(int32_t a, int32_t b, int32_t c) const {
     return geom::dominant_axis(positions[a], positions[b], positions[c]);
   }
-  geom::OrientPlane<IntegerPredicates> plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
+  geom::OrientPlane<IntegerPredicates> plane(int32_t a, int32_t b, int32_t c) const {
+    return {this, a, b, c};
+  }
 };
 
 /// Decides uncertain tests with IntegerPredicates (the same decision procedures).
 class IntegerResolver final : public detect::ExactResolver {
  public:
-  void edge_hits(const detect::ExactContext& context, std::span<const detect::EdgeTriangleTask> tasks,
-                 std::span<uint8_t> hit) override {
+  void edge_hits(const detect::ExactContext& context,
+                 std::span<const detect::EdgeTriangleTask> tasks, std::span<uint8_t> hit) override {
     const IntegerPredicates pred{context.positions.data()};
     for (size_t i = 0; i < tasks.size(); ++i) {
       const auto [p, q] = context.topology->edges[tasks[i].edge];
@@ -58,7 +66,8 @@ class IntegerResolver final : public detect::ExactResolver {
                   std::span<detect::PairKind> kinds) override {
     const IntegerPredicates pred{context.positions.data()};
     for (size_t i = 0; i < pairs.size(); ++i)
-      kinds[i] = decide(geom::is_crossing(pred, context.topology->triangles[pairs[i].a], context.topology->triangles[pairs[i].b]))
+      kinds[i] = decide(geom::is_crossing(pred, context.topology->triangles[pairs[i].a],
+                                          context.topology->triangles[pairs[i].b]))
                      ? detect::PairKind::crossing
                      : detect::PairKind::touching;
     kind_calls += pairs.size();
@@ -76,7 +85,8 @@ class IntegerResolver final : public detect::ExactResolver {
     return pred.orient3d(t.v[0], t.v[1], t.v[2], v);
   }
   static bool decide(geom::Answer a) {
-    if (a == geom::Answer::uncertain) throw std::logic_error("exact provider left a test undecided");
+    if (a == geom::Answer::uncertain)
+      throw std::logic_error("exact provider left a test undecided");
     return a == geom::Answer::yes;
   }
   size_t edge_calls = 0;

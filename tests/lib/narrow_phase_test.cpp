@@ -34,7 +34,8 @@ TEST(HandBuilt, AnswerDoesNotDependOnFaceOrderOrCornerRotation) {
     for (auto& t : swapped.triangles) t = {{t.v[1], t.v[2], t.v[0]}};
     const detect::FrameResult result = check_mesh(transformed(swapped, kShear, {1, 2, 3}));
     ASSERT_EQ(result.pairs.size(), c.pairs.size()) << c.name;
-    for (size_t i = 0; i < c.pairs.size(); ++i) EXPECT_EQ(result.pairs[i].kind, c.pairs[i].kind) << c.name;
+    for (size_t i = 0; i < c.pairs.size(); ++i)
+      EXPECT_EQ(result.pairs[i].kind, c.pairs[i].kind) << c.name;
     std::vector<int32_t> degenerate;
     for (int32_t d : c.degenerate) degenerate.push_back(1 - d);
     EXPECT_EQ(result.degenerate, degenerate) << c.name;
@@ -53,8 +54,10 @@ TEST(Predicates, FilterNeverGivesAWrongSignOnSmallIntegers) {
     const IntegerPredicates exact{points.data()};
     const geom::FilteredPredicates filtered{points.data()};
     const geom::Sign e3 = exact.orient3d(0, 1, 2, 3), f3 = filtered.orient3d(0, 1, 2, 3);
-    if (f3 == geom::Sign::uncertain) ++uncertain;
-    else ASSERT_EQ(f3, e3) << "trial " << trial << " (seed 12345)";
+    if (f3 == geom::Sign::uncertain)
+      ++uncertain;
+    else
+      ASSERT_EQ(f3, e3) << "trial " << trial << " (seed 12345)";
     zero += e3 == geom::Sign::zero;
     for (int axis = 0; axis < 3; ++axis) {
       const geom::Sign e2 = exact.orient2d(0, 1, 2, axis), f2 = filtered.orient2d(0, 1, 2, axis);
@@ -81,11 +84,16 @@ TEST(Predicates, NearDegenerateSignsAreUncertainNotWrong) {
       // Where the filter is certain, the sign must agree with a long double re-evaluation
       // whose error is far below the filter's bound for these magnitudes.
       if (f != geom::Sign::uncertain) {
-        const long double ux = (long double)b.x - a.x, uy = (long double)b.y - a.y, uz = (long double)b.z - a.z;
-        const long double vx = (long double)c.x - a.x, vy = (long double)c.y - a.y, vz = (long double)c.z - a.z;
-        const long double wx = (long double)e.x - a.x, wy = (long double)e.y - a.y, wz = (long double)e.z - a.z;
-        const long double det = ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
-        EXPECT_EQ(f, det > 0 ? geom::Sign::positive : (det < 0 ? geom::Sign::negative : geom::Sign::zero))
+        const long double ux = (long double)b.x - a.x, uy = (long double)b.y - a.y,
+                          uz = (long double)b.z - a.z;
+        const long double vx = (long double)c.x - a.x, vy = (long double)c.y - a.y,
+                          vz = (long double)c.z - a.z;
+        const long double wx = (long double)e.x - a.x, wy = (long double)e.y - a.y,
+                          wz = (long double)e.z - a.z;
+        const long double det =
+            ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
+        EXPECT_EQ(
+            f, det > 0 ? geom::Sign::positive : (det < 0 ? geom::Sign::negative : geom::Sign::zero))
             << "i=" << i << " dz=" << dz;
       }
     }

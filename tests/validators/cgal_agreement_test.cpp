@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <random>
 
+#include "../../validators/src/cgal_predicates.h"
 #include "snag/detect/checker.h"
 #include "snag/detect/cpu_backend.h"
 #include "snag/error.h"
@@ -17,15 +18,14 @@
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/cgal_resolver.h"
 #include "test_paths.h"
-#include "../../validators/src/cgal_predicates.h"
 
 namespace snag::validators {
 namespace {
 
 using Pairs = std::vector<std::pair<int32_t, int32_t>>;
 
-detect::FrameResult snag_check(std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles,
-                               int threads = 2) {
+detect::FrameResult snag_check(std::span<const geom::Vec3d> positions,
+                               std::span<const geom::Tri> triangles, int threads = 2) {
   detect::Checker checker(detect::make_cpu_backend(threads), make_cgal_resolver());
   checker.set_triangles(triangles, static_cast<int32_t>(positions.size()));
   return checker.check(positions);
@@ -40,7 +40,8 @@ Pairs ids_of(const std::vector<detect::FacePair>& pairs) {
 /// The kind from CGAL's exact construction of the intersection: a crossing is a segment of
 /// positive length between non-coplanar triangles that each have corners strictly on both
 /// sides of the other's plane.
-detect::PairKind reference_kind(std::span<const geom::Vec3d> positions, const geom::Tri& f, const geom::Tri& g) {
+detect::PairKind reference_kind(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                                const geom::Tri& g) {
   using K = CGAL::Exact_predicates_exact_constructions_kernel;
   auto P = [&](int32_t v) { return K::Point_3(positions[v].x, positions[v].y, positions[v].z); };
   const K::Triangle_3 tf(P(f.v[0]), P(f.v[1]), P(f.v[2])), tg(P(g.v[0]), P(g.v[1]), P(g.v[2]));
@@ -61,7 +62,8 @@ detect::PairKind reference_kind(std::span<const geom::Vec3d> positions, const ge
   return detect::PairKind::touching;
 }
 
-void expect_kinds_match(std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles,
+void expect_kinds_match(std::span<const geom::Vec3d> positions,
+                        std::span<const geom::Tri> triangles,
                         const std::vector<detect::FacePair>& pairs, const std::string& what) {
   for (const auto& p : pairs)
     ASSERT_EQ(p.kind, reference_kind(positions, triangles[p.a], triangles[p.b]))
@@ -81,7 +83,8 @@ Soup lattice_soup(int32_t n, int range, uint32_t seed, double scale, double offs
   std::uniform_int_distribution<int32_t> pick(0, 2 * n - 1);
   Soup soup;
   for (int32_t v = 0; v < 2 * n; ++v)
-    soup.positions.push_back({coord(rng) * scale + offset, coord(rng) * scale - offset, coord(rng) * scale});
+    soup.positions.push_back(
+        {coord(rng) * scale + offset, coord(rng) * scale - offset, coord(rng) * scale});
   for (int32_t t = 0; t < n; ++t) soup.triangles.push_back({{pick(rng), pick(rng), pick(rng)}});
   return soup;
 }
@@ -108,7 +111,8 @@ TEST(ExactProvider, AgreesWithTheFilterWheneverTheFilterIsCertain) {
     ASSERT_EQ(f, exact.orient3d(0, 1, 2, 3)) << "trial " << trial << " (seed 2026)";
     for (int axis = 0; axis < 3; ++axis) {
       const geom::Sign f2 = filtered.orient2d(0, 1, 3, axis);
-      if (f2 != geom::Sign::uncertain) ASSERT_EQ(f2, exact.orient2d(0, 1, 3, axis)) << "trial " << trial;
+      if (f2 != geom::Sign::uncertain)
+        ASSERT_EQ(f2, exact.orient2d(0, 1, 3, axis)) << "trial " << trial;
     }
   }
   EXPECT_GT(uncertain, 1000) << "the near-degenerate inputs should defeat the filter often";
@@ -117,25 +121,29 @@ TEST(ExactProvider, AgreesWithTheFilterWheneverTheFilterIsCertain) {
 TEST(CgalAgreement, LatticeSoupsPairForPairWithExactKinds) {
   for (uint32_t seed = 1; seed <= 30; ++seed) {
     const double scale = seed % 2 ? 0.1 : 3.0;  // 0.1 is not a binary fraction
-    const Soup soup = lattice_soup(60 + static_cast<int32_t>(seed % 7) * 20, 4, seed, scale, seed % 3 ? 0.7 : 1e6);
+    const Soup soup = lattice_soup(60 + static_cast<int32_t>(seed % 7) * 20, 4, seed, scale,
+                                   seed % 3 ? 0.7 : 1e6);
     const Pairs expected = cgal_soup_self_intersections(soup.positions, soup.triangles);
     for (int threads : {1, 2}) {
       const detect::FrameResult result = snag_check(soup.positions, soup.triangles, threads);
       ASSERT_EQ(ids_of(result.pairs), expected) << "seed " << seed << " threads " << threads;
-      expect_kinds_match(soup.positions, soup.triangles, result.pairs, "seed " + std::to_string(seed));
+      expect_kinds_match(soup.positions, soup.triangles, result.pairs,
+                         "seed " + std::to_string(seed));
     }
   }
 }
 
 TEST(CgalAgreement, SampleSequenceMatchesSelfIntersections) {
   const auto dir = test::source_dir() / "samples" / "drape";
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no samples/drape under " << test::source_dir();
+  if (!std::filesystem::is_directory(dir))
+    GTEST_SKIP() << "no samples/drape under " << test::source_dir();
   int frames = 0, with_pairs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".obj") continue;
     const mesh::Mesh mesh = io::read_mesh(entry.path());
     const detect::FrameResult result = snag_check(mesh.positions, mesh.triangles);
-    ASSERT_EQ(ids_of(result.pairs), cgal_self_intersections(mesh.positions, mesh.triangles)) << entry.path();
+    ASSERT_EQ(ids_of(result.pairs), cgal_self_intersections(mesh.positions, mesh.triangles))
+        << entry.path();
     expect_kinds_match(mesh.positions, mesh.triangles, result.pairs, entry.path().string());
     ++frames;
     with_pairs += !result.pairs.empty();
@@ -146,7 +154,8 @@ TEST(CgalAgreement, SampleSequenceMatchesSelfIntersections) {
 
 TEST(CgalReference, SequenceReusingTheMeshMatchesFreshMeshes) {
   const auto dir = test::source_dir() / "samples" / "drape";
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no samples/drape under " << test::source_dir();
+  if (!std::filesystem::is_directory(dir))
+    GTEST_SKIP() << "no samples/drape under " << test::source_dir();
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     if (entry.path().extension() == ".obj") files.push_back(entry.path());
@@ -175,7 +184,9 @@ class DataAgreement : public ::testing::TestWithParam<DataFile> {};
 
 TEST_P(DataAgreement, MatchesCgalPairForPairAndTheReferenceCount) {
   const auto data = test::data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent (set SNAG_DATA_DIR): skipping the real-data agreement";
+  if (data.empty())
+    GTEST_SKIP()
+        << "../shared/data is absent (set SNAG_DATA_DIR): skipping the real-data agreement";
   const DataFile& file = GetParam();
   mesh::Mesh mesh = io::read_mesh(data / file.path);
   ASSERT_EQ(mesh.triangles.size(), file.triangles);
@@ -196,7 +207,8 @@ TEST_P(DataAgreement, MatchesCgalPairForPairAndTheReferenceCount) {
   EXPECT_EQ(result.pairs.size(), file.cgal_pairs) << "reference count of ../shared/data/README.md";
   ASSERT_EQ(ids_of(result.pairs), expected);
   EXPECT_TRUE(result.degenerate.empty()) << result.degenerate.size() << " degenerate faces";
-  if (result.pairs.size() < 20000) expect_kinds_match(mesh.positions, mesh.triangles, result.pairs, file.path);
+  if (result.pairs.size() < 20000)
+    expect_kinds_match(mesh.positions, mesh.triangles, result.pairs, file.path);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -211,12 +223,16 @@ INSTANTIATE_TEST_SUITE_P(
                       DataFile{"scalable-ccd/armadillo-rollers/327.ply", 24242, 0},
                       DataFile{"scalable-ccd/n-body-simulation/balls16_18.ply", 146480, 4916},
                       DataFile{"scalable-ccd/n-body-simulation/balls16_19.ply", 146480, 4401},
-                      DataFile{"ipc-toolkit/thick-cloth/t0.ply", 404, 0}, DataFile{"ipc-toolkit/thick-cloth/t1.ply", 404, 46},
-                      DataFile{"ipc-toolkit/two-cubes-far.ply", 480, 0}, DataFile{"ipc-toolkit/two-cubes-close.ply", 480, 0},
+                      DataFile{"ipc-toolkit/thick-cloth/t0.ply", 404, 0},
+                      DataFile{"ipc-toolkit/thick-cloth/t1.ply", 404, 46},
+                      DataFile{"ipc-toolkit/two-cubes-far.ply", 480, 0},
+                      DataFile{"ipc-toolkit/two-cubes-close.ply", 480, 0},
                       DataFile{"ipc-toolkit/two-cubes-intersecting.ply", 480, 96},
-                      DataFile{"ipc-toolkit/bunny.ply", 5002, 0}, DataFile{"ipc-toolkit/cube.ply", 12, 0},
+                      DataFile{"ipc-toolkit/bunny.ply", 5002, 0},
+                      DataFile{"ipc-toolkit/cube.ply", 12, 0},
                       DataFile{"ipc-toolkit/height-field.ply", 4904, 0},
-                      DataFile{"arrangements/three_cubes.stl", 36, 41}, DataFile{"arrangements/two_spheres.stl", 1600, 132}),
+                      DataFile{"arrangements/three_cubes.stl", 36, 41},
+                      DataFile{"arrangements/two_spheres.stl", 1600, 132}),
     [](const ::testing::TestParamInfo<DataFile>& info) {
       std::string name = info.param.path;
       for (char& c : name)

@@ -12,13 +12,16 @@ namespace snag::validators {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 
 inline geom::Sign to_sign(CGAL::Orientation o) {
-  return o == CGAL::POSITIVE ? geom::Sign::positive : (o == CGAL::NEGATIVE ? geom::Sign::negative : geom::Sign::zero);
+  return o == CGAL::POSITIVE ? geom::Sign::positive
+                             : (o == CGAL::NEGATIVE ? geom::Sign::negative : geom::Sign::zero);
 }
 
 struct CgalPredicates {
   const geom::Vec3d* positions;
 
-  Kernel::Point_3 point(int32_t v) const { return {positions[v].x, positions[v].y, positions[v].z}; }
+  Kernel::Point_3 point(int32_t v) const {
+    return {positions[v].x, positions[v].y, positions[v].z};
+  }
   Kernel::Point_2 point(int32_t v, int axis) const {
     double u, w;
     geom::project(positions[v], axis, u, w);
@@ -34,7 +37,9 @@ struct CgalPredicates {
   int dominant_axis(int32_t a, int32_t b, int32_t c) const {
     return geom::dominant_axis(positions[a], positions[b], positions[c]);
   }
-  geom::OrientPlane<CgalPredicates> plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
+  geom::OrientPlane<CgalPredicates> plane(int32_t a, int32_t b, int32_t c) const {
+    return {this, a, b, c};
+  }
 };
 
 }  // namespace snag::validators

@@ -18,10 +18,13 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Mesh = CGAL::Surface_mesh<Point>;
 
-Point point_of(const geom::Vec3d& p) { return {p.x, p.y, p.z}; }
+Point point_of(const geom::Vec3d& p) {
+  return {p.x, p.y, p.z};
+}
 
 bool degenerate(std::span<const geom::Vec3d> positions, const geom::Tri& t) {
-  return CGAL::collinear(point_of(positions[t.v[0]]), point_of(positions[t.v[1]]), point_of(positions[t.v[2]]));
+  return CGAL::collinear(point_of(positions[t.v[0]]), point_of(positions[t.v[1]]),
+                         point_of(positions[t.v[2]]));
 }
 
 void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
@@ -33,7 +36,8 @@ void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
 
 /// CGAL's do_faces_intersect rules (Polygon_mesh_processing/self_intersections.h), with the
 /// shared vertices of two faces taken from their ids instead of halfedge adjacency.
-bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f, const geom::Tri& g) {
+bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                     const geom::Tri& g) {
   int shared = 0, fi = -1, gi = -1;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -70,17 +74,21 @@ struct CgalSequence::State {
   std::vector<int32_t> triangle_of_face;
 };
 
-CgalSequence::CgalSequence(std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles)
+CgalSequence::CgalSequence(std::span<const geom::Vec3d> positions,
+                           std::span<const geom::Tri> triangles)
     : state_(std::make_unique<State>()) {
   Mesh& mesh = state_->mesh;
   for (const geom::Vec3d& p : positions) mesh.add_vertex(point_of(p));
   for (size_t t = 0; t < triangles.size(); ++t) {
     const geom::Tri& tri = triangles[t];
-    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] || degenerate(positions, tri)) continue;
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] ||
+        degenerate(positions, tri))
+      continue;
     const auto face = mesh.add_face(Mesh::Vertex_index(tri.v[0]), Mesh::Vertex_index(tri.v[1]),
                                     Mesh::Vertex_index(tri.v[2]));
     if (face == Mesh::null_face())
-      throw InternalError("triangle " + std::to_string(t) + " cannot join CGAL's halfedge mesh (non-manifold or "
+      throw InternalError("triangle " + std::to_string(t) +
+                          " cannot join CGAL's halfedge mesh (non-manifold or "
                           "inconsistently oriented)");
     state_->triangle_of_face.push_back(static_cast<int32_t>(t));
   }
@@ -90,12 +98,14 @@ CgalSequence::~CgalSequence() = default;
 
 void CgalSequence::set_positions(std::span<const geom::Vec3d> positions) {
   Mesh& mesh = state_->mesh;
-  for (size_t v = 0; v < positions.size(); ++v) mesh.point(Mesh::Vertex_index(static_cast<uint32_t>(v))) = point_of(positions[v]);
+  for (size_t v = 0; v < positions.size(); ++v)
+    mesh.point(Mesh::Vertex_index(static_cast<uint32_t>(v))) = point_of(positions[v]);
 }
 
 std::vector<std::pair<int32_t, int32_t>> CgalSequence::self_intersections() const {
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
-  CGAL::Polygon_mesh_processing::self_intersections<CGAL::Sequential_tag>(state_->mesh, std::back_inserter(found));
+  CGAL::Polygon_mesh_processing::self_intersections<CGAL::Sequential_tag>(
+      state_->mesh, std::back_inserter(found));
   std::vector<std::pair<int32_t, int32_t>> pairs;
   pairs.reserve(found.size());
   for (const auto& [f, g] : found)
@@ -104,18 +114,22 @@ std::vector<std::pair<int32_t, int32_t>> CgalSequence::self_intersections() cons
   return pairs;
 }
 
-std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
-                                                                 std::span<const geom::Tri> triangles) {
+std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(
+    std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles) {
   return CgalSequence(positions, triangles).self_intersections();
 }
 
-std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(std::span<const geom::Vec3d> positions,
-                                                                      std::span<const geom::Tri> triangles) {
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
+    std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles) {
+  using Box =
+      CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t,
+                                                CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
   std::vector<Box> boxes;
   for (size_t t = 0; t < triangles.size(); ++t) {
     const geom::Tri& tri = triangles[t];
-    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] || degenerate(positions, tri)) continue;
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] ||
+        degenerate(positions, tri))
+      continue;
     const auto box = point_of(positions[tri.v[0]]).bbox() + point_of(positions[tri.v[1]]).bbox() +
                      point_of(positions[tri.v[2]]).bbox();
     boxes.emplace_back(box, static_cast<int32_t>(t));

@@ -18,8 +18,8 @@ bool decided(geom::Answer answer, const char* what) {
 
 class CgalResolver final : public detect::ExactResolver {
  public:
-  void edge_hits(const detect::ExactContext& context, std::span<const detect::EdgeTriangleTask> tasks,
-                 std::span<uint8_t> hit) override {
+  void edge_hits(const detect::ExactContext& context,
+                 std::span<const detect::EdgeTriangleTask> tasks, std::span<uint8_t> hit) override {
     const CgalPredicates pred{context.positions.data()};
     const detect::Topology& topo = *context.topology;
     const auto count = static_cast<int64_t>(tasks.size());
@@ -42,7 +42,8 @@ class CgalResolver final : public detect::ExactResolver {
 #pragma omp parallel for schedule(dynamic, 16) if (count > 256)
     for (int64_t i = 0; i < count; ++i) {
       const bool crossing =
-          decided(geom::is_crossing(pred, topo.triangles[pairs[i].a], topo.triangles[pairs[i].b]), "pair kind");
+          decided(geom::is_crossing(pred, topo.triangles[pairs[i].a], topo.triangles[pairs[i].b]),
+                  "pair kind");
       kinds[i] = crossing ? detect::PairKind::crossing : detect::PairKind::touching;
     }
   }
@@ -60,6 +61,8 @@ class CgalResolver final : public detect::ExactResolver {
 
 }  // namespace
 
-std::shared_ptr<detect::ExactResolver> make_cgal_resolver() { return std::make_shared<CgalResolver>(); }
+std::shared_ptr<detect::ExactResolver> make_cgal_resolver() {
+  return std::make_shared<CgalResolver>();
+}
 
 }  // namespace snag::validators

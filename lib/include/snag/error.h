@@ -14,14 +14,17 @@ class InputError : public std::runtime_error {
  public:
   InputError(std::string path, int64_t line, std::string what, int64_t byte_offset = -1)
       : std::runtime_error(format(path, line, byte_offset, what)),
-        path_(std::move(path)), line_(line), byte_offset_(byte_offset) {}
+        path_(std::move(path)),
+        line_(line),
+        byte_offset_(byte_offset) {}
   const std::string& path() const { return path_; }
-  int64_t line() const { return line_; }            ///< 1-based, 0 when not a line
+  int64_t line() const { return line_; }                ///< 1-based, 0 when not a line
   int64_t byte_offset() const { return byte_offset_; }  ///< -1 when not a byte offset
 
  private:
   // Appends rather than chaining operator+: GCC 12 warns falsely (-Wrestrict) on the chain.
-  static std::string format(const std::string& path, int64_t line, int64_t offset, const std::string& what) {
+  static std::string format(const std::string& path, int64_t line, int64_t offset,
+                            const std::string& what) {
     std::string message = path;
     if (line > 0) message.append(":").append(std::to_string(line));
     if (offset >= 0) message.append(" (byte ").append(std::to_string(offset)).append(")");

@@ -12,7 +12,8 @@ namespace {
 constexpr int32_t kParallelLevel = 4096;
 
 /// The internal nodes of `level`: [first, last).
-void internal_nodes_of_level(const CompleteTree& shape, int32_t level, int32_t& first, int32_t& last) {
+void internal_nodes_of_level(const CompleteTree& shape, int32_t level, int32_t& first,
+                             int32_t& last) {
   first = CompleteTree::level_begin(level);
   last = std::min(CompleteTree::level_begin(level + 1), shape.leaf_count - 1);
 }
@@ -53,7 +54,8 @@ void Tree::build(mesh::MeshView mesh, int threads) {
         lo[2] = std::min(lo[2], c.z), hi[2] = std::max(hi[2], c.z);
       }
       const double extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-      const int axis = (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
+      const int axis =
+          (extent[0] >= extent[1] && extent[0] >= extent[2]) ? 0 : (extent[1] >= extent[2] ? 1 : 2);
       auto* data = triangle_at_.data();
       std::nth_element(data + begin, data + split, data + end, [&](int32_t a, int32_t b) {
         const double ca = geom::coord(centroid[a], axis), cb = geom::coord(centroid[b], axis);
@@ -74,8 +76,8 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
 #pragma omp parallel for num_threads(threads) schedule(static) if (n > kParallelLevel)
   for (int32_t t = 0; t < n; ++t) {
     const geom::Tri tri = mesh.triangles[t];
-    tree.boxes[leaf_of_triangle_[t]] =
-        geom::triangle_box(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
+    tree.boxes[leaf_of_triangle_[t]] = geom::triangle_box(
+        mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
   }
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to
@@ -93,7 +95,8 @@ double Tree::quality() const {
   const int32_t blocks = quality_block_count(shape_);
   if (blocks == 0) return 0.0;
   std::vector<double> block_sums(static_cast<size_t>(blocks));
-  for (int32_t block = 0; block < blocks; ++block) block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
+  for (int32_t block = 0; block < blocks; ++block)
+    block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
   return quality_from_blocks(block_sums.data(), blocks, boxes_[0]);
 }
 

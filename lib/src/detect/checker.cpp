@@ -18,7 +18,8 @@ double seconds_since(Clock::time_point start) {
 
 }  // namespace
 
-Checker::Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver, CheckSettings settings)
+Checker::Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver,
+                 CheckSettings settings)
     : backend_(std::move(backend)), resolver_(std::move(resolver)), settings_(settings) {
   if (!backend_ || !resolver_) throw InternalError("Checker needs a backend and an exact resolver");
 }
@@ -26,7 +27,8 @@ Checker::Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver
 Checker::~Checker() = default;
 
 bool Checker::set_triangles(std::span<const geom::Tri> triangles, int32_t vertex_count) {
-  if (topology_ && topology_->vertex_count == vertex_count && topology_->triangles.size() == triangles.size() &&
+  if (topology_ && topology_->vertex_count == vertex_count &&
+      topology_->triangles.size() == triangles.size() &&
       std::equal(triangles.begin(), triangles.end(), topology_->triangles.begin(),
                  [](const geom::Tri& x, const geom::Tri& y) {
                    return x.v[0] == y.v[0] && x.v[1] == y.v[1] && x.v[2] == y.v[2];
@@ -41,8 +43,8 @@ bool Checker::set_triangles(std::span<const geom::Tri> triangles, int32_t vertex
 FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   if (!topology_) throw InternalError("Checker::check called before set_triangles");
   if (static_cast<int64_t>(positions.size()) != topology_->vertex_count)
-    throw InternalError("frame has " + std::to_string(positions.size()) + " vertices, topology has " +
-                        std::to_string(topology_->vertex_count));
+    throw InternalError("frame has " + std::to_string(positions.size()) +
+                        " vertices, topology has " + std::to_string(topology_->vertex_count));
   FrameResult result;
   if (topology_->triangle_count() == 0) return result;
   const ExactContext context{positions, topology_.get()};

@@ -30,7 +30,9 @@ struct ThreadSink {
   void hit(int32_t edge, int32_t triangle) { hits.push_back({edge, triangle}); }
   void uncertain(int32_t edge, int32_t triangle) { uncertain_tests.push_back({edge, triangle}); }
   void miss() { ++misses; }
-  void duplicate(int32_t a, int32_t b) { duplicates.push_back({std::min(a, b), std::max(a, b), PairKind::touching}); }
+  void duplicate(int32_t a, int32_t b) {
+    duplicates.push_back({std::min(a, b), std::max(a, b), PairKind::touching});
+  }
 };
 
 class CpuBackend final : public Backend {
@@ -60,9 +62,15 @@ class CpuBackend final : public Backend {
     return scan;
   }
 
-  void build() override { tree_.build(mesh_view(), threads_); }
-  void refit() override { tree_.refit(mesh_view(), threads_); }
-  double tree_quality() override { return tree_.quality(); }
+  void build() override {
+    tree_.build(mesh_view(), threads_);
+  }
+  void refit() override {
+    tree_.refit(mesh_view(), threads_);
+  }
+  double tree_quality() override {
+    return tree_.quality();
+  }
 
   FilteredFrame detect(std::span<const int32_t> degenerate) override {
     const Topology& topo = *topology_;
@@ -73,12 +81,18 @@ class CpuBackend final : public Backend {
     std::vector<uint8_t> degenerate_flags(static_cast<size_t>(n), 0);
     for (int32_t t : degenerate) degenerate_flags[t] = 1;
     const std::vector<uint8_t> owned = ownership_without(topo, degenerate);
-    const TopologyView view{topo.triangles.data(),   topo.edges.data(),         topo.triangle_edges.data(),
-                            owned.data(),            topo.listed_vertex.data(), topo.every_vertex_listed,
-                            n,                       static_cast<int32_t>(topo.edges.size())};
+    const TopologyView view{topo.triangles.data(),
+                            topo.edges.data(),
+                            topo.triangle_edges.data(),
+                            owned.data(),
+                            topo.listed_vertex.data(),
+                            topo.every_vertex_listed,
+                            n,
+                            static_cast<int32_t>(topo.edges.size())};
     planes_.resize(static_cast<size_t>(n));
 #pragma omp parallel for num_threads(threads_) schedule(static)
-    for (int32_t t = 0; t < n; ++t) planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+    for (int32_t t = 0; t < n; ++t)
+      planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
     const FrameView frame_view{positions_.data(), planes_.data()};
     const bvh::TreeView tree = tree_.view();
 
@@ -101,12 +115,14 @@ class CpuBackend final : public Backend {
       // in leaf order; dynamic chunks because groups in dense regions cost more.
       const int32_t level = bvh::group_level(tree.shape);
       const int32_t first_group = bvh::CompleteTree::level_begin(level);
-      const int32_t last_group = std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+      const int32_t last_group =
+          std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
 #pragma omp for schedule(dynamic, 64)
       for (int32_t group = first_group; group < last_group; ++group) {
         bvh::for_each_later_overlap_grouped(tree, group, [&](int32_t t, int32_t x) {
           if (degenerate_flags[t] || degenerate_flags[x] ||
-              is_listed_neighbor(topo.triangles[t], topo.triangles[x], view.listed_vertex, view.every_vertex_listed))
+              is_listed_neighbor(topo.triangles[t], topo.triangles[x], view.listed_vertex,
+                                 view.every_vertex_listed))
             return;
           ++sink.candidates;
           test_candidate_pair(frame_view, view, t, x, sink);
@@ -118,24 +134,28 @@ class CpuBackend final : public Backend {
     std::vector<FacePair> duplicates;
     for (ThreadSink& sink : sinks) {
       hits.insert(hits.end(), sink.hits.begin(), sink.hits.end());
-      frame.uncertain.insert(frame.uncertain.end(), sink.uncertain_tests.begin(), sink.uncertain_tests.end());
+      frame.uncertain.insert(frame.uncertain.end(), sink.uncertain_tests.begin(),
+                             sink.uncertain_tests.end());
       duplicates.insert(duplicates.end(), sink.duplicates.begin(), sink.duplicates.end());
       frame.candidate_pairs += sink.candidates;
       frame.filtered_tests += sink.misses + static_cast<int64_t>(sink.hits.size());
     }
     // Thread scheduling decides the order of the merged lists; sorting makes it canonical.
-    std::sort(frame.uncertain.begin(), frame.uncertain.end(), [](const EdgeTriangleTask& x, const EdgeTriangleTask& y) {
-      return x.edge != y.edge ? x.edge < y.edge : x.triangle < y.triangle;
-    });
+    std::sort(frame.uncertain.begin(), frame.uncertain.end(),
+              [](const EdgeTriangleTask& x, const EdgeTriangleTask& y) {
+                return x.edge != y.edge ? x.edge < y.edge : x.triangle < y.triangle;
+              });
     frame.traverse_seconds = seconds_since(start);
 
     const auto classify_start = Clock::now();
     frame.pairs = expand_hits(topo, hits, degenerate_flags);
-    std::sort(duplicates.begin(), duplicates.end(),
-              [](const FacePair& x, const FacePair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    std::sort(duplicates.begin(), duplicates.end(), [](const FacePair& x, const FacePair& y) {
+      return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
     std::vector<uint8_t> pair_flags(frame.pairs.size(), 1), duplicate_flags(duplicates.size(), 1);
     merge_pairs(frame.pairs, pair_flags, duplicates, duplicate_flags);
-    const int64_t uncertain_kinds = classify_pairs(positions_, topo, frame.pairs, frame.kind_certain, threads_, planes_.data());
+    const int64_t uncertain_kinds =
+        classify_pairs(positions_, topo, frame.pairs, frame.kind_certain, threads_, planes_.data());
     frame.filtered_tests += static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
     frame.classify_seconds = seconds_since(classify_start);
     return frame;
@@ -156,6 +176,8 @@ class CpuBackend final : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_cpu_backend(int threads) { return std::make_unique<CpuBackend>(threads); }
+std::unique_ptr<Backend> make_cpu_backend(int threads) {
+  return std::make_unique<CpuBackend>(threads);
+}
 
 }  // namespace snag::detect

@@ -41,7 +41,8 @@ std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTria
   std::vector<uint64_t> keys;
   keys.reserve(hits.size() * 2);
   for (const EdgeTriangleTask& hit : hits) {
-    for (int32_t i = topo.edge_face_offsets[hit.edge]; i < topo.edge_face_offsets[hit.edge + 1]; ++i) {
+    for (int32_t i = topo.edge_face_offsets[hit.edge]; i < topo.edge_face_offsets[hit.edge + 1];
+         ++i) {
       const int32_t face = topo.edge_faces[i];
       if (face == hit.triangle || degenerate_flags[face]) continue;
       const auto a = static_cast<uint64_t>(std::min(face, hit.triangle));
@@ -53,20 +54,22 @@ std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTria
   std::vector<FacePair> pairs(keys.size());
   const uint64_t low = (uint64_t{1} << id_bits) - 1;
   for (size_t i = 0; i < keys.size(); ++i)
-    pairs[i] = {static_cast<int32_t>(keys[i] >> id_bits), static_cast<int32_t>(keys[i] & low), PairKind::touching};
+    pairs[i] = {static_cast<int32_t>(keys[i] >> id_bits), static_cast<int32_t>(keys[i] & low),
+                PairKind::touching};
   return pairs;
 }
 
-void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags, std::span<const FacePair> more,
-                 std::span<const uint8_t> more_flags) {
+void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags,
+                 std::span<const FacePair> more, std::span<const uint8_t> more_flags) {
   std::vector<FacePair> merged;
   std::vector<uint8_t> flags;
   merged.reserve(into.size() + more.size());
   flags.reserve(into.size() + more.size());
   size_t i = 0, j = 0;
   while (i < into.size() || j < more.size()) {
-    const bool take_into = j == more.size() ||
-                           (i < into.size() && (into[i].a != more[j].a ? into[i].a < more[j].a : into[i].b <= more[j].b));
+    const bool take_into =
+        j == more.size() || (i < into.size() && (into[i].a != more[j].a ? into[i].a < more[j].a
+                                                                        : into[i].b <= more[j].b));
     if (take_into) {
       if (j < more.size() && into[i].a == more[j].a && into[i].b == more[j].b) ++j;
       merged.push_back(into[i]);
@@ -82,8 +85,9 @@ void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags, 
   into_flags = std::move(flags);
 }
 
-int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topo, std::span<FacePair> pairs,
-                       std::vector<uint8_t>& certain, int threads, const geom::PlaneCoefficients* planes) {
+int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topo,
+                       std::span<FacePair> pairs, std::vector<uint8_t>& certain, int threads,
+                       const geom::PlaneCoefficients* planes) {
   certain.assign(pairs.size(), 1);
   const geom::FilteredPredicates pred{positions.data()};
   int64_t uncertain = 0;

@@ -10,9 +10,9 @@ namespace snag::detect {
 namespace {
 
 struct EdgeRecord {
-  int32_t u, v;      // endpoints, u < v
+  int32_t u, v;  // endpoints, u < v
   int32_t triangle;
-  int32_t corner;    // the triangle's edge k joins corners k and k + 1
+  int32_t corner;  // the triangle's edge k joins corners k and k + 1
 };
 
 /// Lists the pairs of triangles around each vertex of valence at most kMaxListedValence.
@@ -71,8 +71,8 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
     const geom::Tri& tri = triangles[t];
     for (int k = 0; k < 3; ++k)
       if (tri.v[k] < 0 || tri.v[k] >= vertex_count)
-        throw InternalError("triangle " + std::to_string(t) + " uses vertex " + std::to_string(tri.v[k]) +
-                            " of " + std::to_string(vertex_count));
+        throw InternalError("triangle " + std::to_string(t) + " uses vertex " +
+                            std::to_string(tri.v[k]) + " of " + std::to_string(vertex_count));
     if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0]) {
       // A repeated corner: zero area in every frame, left out of the search, owns nothing.
       topo.index_degenerate.push_back(t);
@@ -103,7 +103,8 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
     topo.triangle_edges[rec.triangle][rec.corner] = edge;
     topo.edge_faces.push_back(rec.triangle);
   }
-  if (!records.empty()) topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
+  if (!records.empty())
+    topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
   make_neighbor_pairs(topo);
   return topo;
 }
@@ -111,7 +112,9 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
 std::vector<uint8_t> ownership_without(const Topology& topo, std::span<const int32_t> degenerate) {
   std::vector<uint8_t> owned = topo.owned_edges;
   if (degenerate.empty()) return owned;
-  auto is_degenerate = [&](int32_t t) { return std::binary_search(degenerate.begin(), degenerate.end(), t); };
+  auto is_degenerate = [&](int32_t t) {
+    return std::binary_search(degenerate.begin(), degenerate.end(), t);
+  };
   for (int32_t d : degenerate) {
     for (int k = 0; k < 3; ++k) {
       if (!(owned[d] & (1u << k))) continue;

@@ -17,14 +17,15 @@ namespace snag::bvh {
 /// Non-owning view, passed by value into kernels and OpenMP loops.
 struct TreeView {
   CompleteTree shape;
-  geom::Box3f* boxes = nullptr;             ///< 2n - 1, breadth-first
-  const int32_t* triangle_at = nullptr;     ///< n: the triangle of each leaf position
+  geom::Box3f* boxes = nullptr;          ///< 2n - 1, breadth-first
+  const int32_t* triangle_at = nullptr;  ///< n: the triangle of each leaf position
 };
 
 /// Box of leaf `leaf` from its triangle's current corners.
 SNAG_HD_INLINE void refit_leaf(int32_t leaf, TreeView tree, mesh::MeshView mesh) {
   const geom::Tri t = mesh.triangles[tree.triangle_at[tree.shape.position_of(leaf)]];
-  tree.boxes[leaf] = geom::triangle_box(mesh.positions[t.v[0]], mesh.positions[t.v[1]], mesh.positions[t.v[2]]);
+  tree.boxes[leaf] =
+      geom::triangle_box(mesh.positions[t.v[0]], mesh.positions[t.v[1]], mesh.positions[t.v[2]]);
 }
 
 /// Box of internal node `node` from its children's (already refit) boxes.
@@ -78,9 +79,11 @@ SNAG_HD_INLINE int32_t quality_block_count(const CompleteTree& shape) {
 }
 
 /// The sum of block `block`'s internal-node half areas.
-SNAG_HD_INLINE double quality_block_sum(const geom::Box3f* boxes, const CompleteTree& shape, int32_t block) {
+SNAG_HD_INLINE double quality_block_sum(const geom::Box3f* boxes, const CompleteTree& shape,
+                                        int32_t block) {
   const int32_t begin = block * kQualityBlock;
-  const int32_t end = begin + kQualityBlock < shape.leaf_count - 1 ? begin + kQualityBlock : shape.leaf_count - 1;
+  const int32_t end =
+      begin + kQualityBlock < shape.leaf_count - 1 ? begin + kQualityBlock : shape.leaf_count - 1;
   double sum = 0.0;
   for (int32_t node = begin; node < end; ++node) sum += geom::half_area(boxes[node]);
   return sum;
@@ -88,7 +91,8 @@ SNAG_HD_INLINE double quality_block_sum(const geom::Box3f* boxes, const Complete
 
 /// Quality from the block sums: their sum, in order, over the root's half area (0 without an
 /// internal node or for a root of zero area).
-SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t blocks, const geom::Box3f& root) {
+SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t blocks,
+                                          const geom::Box3f& root) {
   double sum = 0.0;
   for (int32_t block = 0; block < blocks; ++block) sum += block_sums[block];
   const double root_area = geom::half_area(root);
@@ -97,7 +101,9 @@ SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t bloc
 
 /// The level whose nodes group leaves for for_each_later_overlap_grouped: D - 2, where every
 /// node is internal and holds 2 to 4 leaves (those of levels D - 1 and D below it).
-inline int32_t group_level(const CompleteTree& shape) { return shape.depth >= 2 ? shape.depth - 2 : 0; }
+inline int32_t group_level(const CompleteTree& shape) {
+  return shape.depth >= 2 ? shape.depth - 2 : 0;
+}
 
 /// The per-leaf query of for_each_later_overlap, run for the (up to four) leaves under node
 /// `group` of group_level() at once: calls visit(member_triangle, other_triangle) for every
@@ -135,7 +141,8 @@ inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&&
   for (int a = 0; a < members; ++a)
     for (int b = a + 1; b < members; ++b) {
       const geom::Box3f& ba = tree.boxes[shape.leaf_at(begin + a)];
-      if (geom::overlap(ba, tree.boxes[shape.leaf_at(begin + b)])) visit(member_triangle[a], member_triangle[b]);
+      if (geom::overlap(ba, tree.boxes[shape.leaf_at(begin + b)]))
+        visit(member_triangle[a], member_triangle[b]);
     }
   // Members against the later subtrees: the right siblings of the group's left-child ancestors.
   for (int32_t node = group; node > 0; node = (node - 1) >> 1) {

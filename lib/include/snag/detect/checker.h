@@ -27,7 +27,8 @@ struct CheckSettings {
 class Checker {
  public:
   /// `resolver` decides what the filter cannot; it must not be null.
-  Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver, CheckSettings settings = {});
+  Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver,
+          CheckSettings settings = {});
   ~Checker();
 
   /// Sets the triangles (indices into each frame's positions). Returns true when they differ

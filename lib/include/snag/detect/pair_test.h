@@ -10,15 +10,18 @@
 
 namespace snag::detect {
 
-SNAG_HD_INLINE bool is_corner_of(int32_t v, const geom::Tri& x) { return v == x.v[0] || v == x.v[1] || v == x.v[2]; }
+SNAG_HD_INLINE bool is_corner_of(int32_t v, const geom::Tri& x) {
+  return v == x.v[0] || v == x.v[1] || v == x.v[2];
+}
 
 /// Whether the pair is tested by the neighbour pass (it shares a listed vertex, see
 /// Topology::neighbor_pairs) rather than from the traversal.
-SNAG_HD_INLINE bool is_listed_neighbor(const geom::Tri& t, const geom::Tri& x, const uint8_t* listed_vertex,
-                                       bool every_vertex_listed) {
+SNAG_HD_INLINE bool is_listed_neighbor(const geom::Tri& t, const geom::Tri& x,
+                                       const uint8_t* listed_vertex, bool every_vertex_listed) {
   if (every_vertex_listed) {  // the usual case: sharing any vertex is enough
     bool shared = false;
-    for (int i = 0; i < 3; ++i) shared |= (t.v[i] == x.v[0]) | (t.v[i] == x.v[1]) | (t.v[i] == x.v[2]);
+    for (int i = 0; i < 3; ++i)
+      shared |= (t.v[i] == x.v[0]) | (t.v[i] == x.v[1]) | (t.v[i] == x.v[2]);
     return shared;
   }
   bool listed = false;
@@ -31,11 +34,13 @@ SNAG_HD_INLINE bool is_listed_neighbor(const geom::Tri& t, const geom::Tri& x, c
 
 /// Which corners of `t` are vertices of `x` (bit i for corner i of t) and which corners of `x`
 /// are vertices of `t`, from the nine id comparisons combined without branches.
-SNAG_HD_INLINE void shared_corners(const geom::Tri& t, const geom::Tri& x, uint32_t& t_shared, uint32_t& x_shared) {
+SNAG_HD_INLINE void shared_corners(const geom::Tri& t, const geom::Tri& x, uint32_t& t_shared,
+                                   uint32_t& x_shared) {
   uint32_t equal = 0;  // bit 3 i + j: t.v[i] == x.v[j]
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) equal |= static_cast<uint32_t>(t.v[i] == x.v[j]) << (3 * i + j);
-  t_shared = ((equal & 7u) != 0) | (((equal >> 3) & 7u) != 0) << 1 | (((equal >> 6) & 7u) != 0) << 2;
+  t_shared =
+      ((equal & 7u) != 0) | (((equal >> 3) & 7u) != 0) << 1 | (((equal >> 6) & 7u) != 0) << 2;
   const uint32_t columns = equal | (equal >> 3) | (equal >> 6);
   x_shared = columns & 7u;
 }
@@ -51,8 +56,10 @@ SNAG_HD_INLINE bool separated(const geom::Sign side[3], uint32_t shared) {
   for (int i = 0; i < 3; ++i) {
     if (shared & (1u << i)) continue;
     if (side[i] != geom::Sign::positive && side[i] != geom::Sign::negative) return false;
-    if (common == geom::Sign::zero) common = side[i];
-    else if (side[i] != common) return false;
+    if (common == geom::Sign::zero)
+      common = side[i];
+    else if (side[i] != common)
+      return false;
   }
   return common != geom::Sign::zero;
 }
@@ -60,9 +67,9 @@ SNAG_HD_INLINE bool separated(const geom::Sign side[3], uint32_t shared) {
 /// Tests the edges triangle `t` represents against triangle `x`; `side` holds t's corners'
 /// sides w.r.t. x's plane.
 template <class P, class Sink>
-SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, int32_t t, const geom::Tri& tt,
-                                     uint8_t owned, uint32_t shared, int32_t x, const geom::Tri& xt,
-                                     const geom::Sign side[3], Sink& sink) {
+SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, int32_t t,
+                                     const geom::Tri& tt, uint8_t owned, uint32_t shared, int32_t x,
+                                     const geom::Tri& xt, const geom::Sign side[3], Sink& sink) {
   for (int k = 0; k < 3; ++k) {
     if (!(owned & (1u << k))) continue;
     const int32_t p = tt.v[k], q = tt.v[(k + 1) % 3];
@@ -70,9 +77,15 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
     if ((shared & edge_corners) == edge_corners) continue;  // an edge of x itself
     const int32_t edge = topo.triangle_edges[t][k];
     switch (geom::edge_hits_triangle(pred, p, q, xt, side[k], side[(k + 1) % 3])) {
-      case geom::Answer::yes: sink.hit(edge, x); break;
-      case geom::Answer::uncertain: sink.uncertain(edge, x); break;
-      case geom::Answer::no: sink.miss(); break;
+      case geom::Answer::yes:
+        sink.hit(edge, x);
+        break;
+      case geom::Answer::uncertain:
+        sink.uncertain(edge, x);
+        break;
+      case geom::Answer::no:
+        sink.miss();
+        break;
     }
   }
 }
@@ -84,14 +97,16 @@ struct FrameView {
   const geom::PlaneCoefficients* planes = nullptr;
 };
 
-SNAG_HD_INLINE geom::PlaneCoefficients triangle_plane(const geom::Vec3d* positions, const geom::Tri& t) {
+SNAG_HD_INLINE geom::PlaneCoefficients triangle_plane(const geom::Vec3d* positions,
+                                                      const geom::Tri& t) {
   return geom::PlaneCoefficients::of(positions[t.v[0]], positions[t.v[1]], positions[t.v[2]]);
 }
 
 /// The sides of t's corners w.r.t. the plane of triangle x (`plane`): zero for the corners
 /// in `shared` (vertices of x); orient3d(x0, x1, x2, corner) otherwise, bit for bit.
-SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions, const geom::PlaneCoefficients& plane,
-                                  const geom::Tri& t, uint32_t shared, const geom::Tri& x, geom::Sign side[3]) {
+SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions,
+                                  const geom::PlaneCoefficients& plane, const geom::Tri& t,
+                                  uint32_t shared, const geom::Tri& x, geom::Sign side[3]) {
   const geom::Vec3d origin = positions[x.v[0]];
   for (int i = 0; i < 3; ++i) {
     if (shared & (1u << i)) {
@@ -101,11 +116,13 @@ SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions, const geom::Plan
     const geom::Vec3d d = positions[t.v[i]];
     const double wx = d.x - origin.x, wy = d.y - origin.y, wz = d.z - origin.z;
     const double det = wx * plane.minor[0] + wy * plane.minor[1] + wz * plane.minor[2];
-    const double perm = fabs(wx) * plane.permanent[0] + fabs(wy) * plane.permanent[1] + fabs(wz) * plane.permanent[2];
+    const double perm = fabs(wx) * plane.permanent[0] + fabs(wy) * plane.permanent[1] +
+                        fabs(wz) * plane.permanent[2];
     if (perm >= geom::detail::kMinPermanent && fabs(det) > geom::detail::kOrient3dBound * perm)
       side[i] = det > 0 ? geom::Sign::positive : geom::Sign::negative;
     else
-      side[i] = geom::detail::plane_side_rare(origin, positions[x.v[1]], positions[x.v[2]], d, perm);
+      side[i] =
+          geom::detail::plane_side_rare(origin, positions[x.v[1]], positions[x.v[2]], d, perm);
   }
 }
 
@@ -119,8 +136,8 @@ SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions, const geom::Plan
 /// The rejection by sides comes first: it settles most pairs (96% of a cloth's neighbour
 /// pairs) before anything else of the pair is loaded.
 template <class Sink>
-SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& topo, int32_t t, int32_t x,
-                                    uint32_t t_shared, uint32_t x_shared, Sink& sink) {
+SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& topo, int32_t t,
+                                    int32_t x, uint32_t t_shared, uint32_t x_shared, Sink& sink) {
   const geom::Tri tt = topo.triangles[t], xt = topo.triangles[x];
   if (t_shared == 7u) {
     sink.duplicate(t, x);
@@ -139,7 +156,8 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
 
 /// The narrow phase of a candidate pair from the traversal (shared corners computed here).
 template <class Sink>
-SNAG_HD void test_candidate_pair(const FrameView& frame, const TopologyView& topo, int32_t t, int32_t x, Sink& sink) {
+SNAG_HD void test_candidate_pair(const FrameView& frame, const TopologyView& topo, int32_t t,
+                                 int32_t x, Sink& sink) {
   uint32_t t_shared, x_shared;
   shared_corners(topo.triangles[t], topo.triangles[x], t_shared, x_shared);
   test_pair_given_shared(frame, topo, t, x, t_shared, x_shared, sink);

@@ -20,13 +20,14 @@ std::vector<FacePair> expand_hits(const Topology& topology, std::span<const Edge
 
 /// Merges two sorted unique pair lists (kinds of `a` win on equal pairs), keeping a flag list
 /// aligned with the result.
-void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags, std::span<const FacePair> more,
-                 std::span<const uint8_t> more_flags);
+void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags,
+                 std::span<const FacePair> more, std::span<const uint8_t> more_flags);
 
 /// Sets each pair's kind with the double filter; certain[i] = 0 where the filter could not
 /// tell (the caller decides those exactly). `planes`, when given, are the frame's triangle
 /// planes (pair_test.h), saving their recomputation. Returns how many were uncertain.
-int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topology, std::span<FacePair> pairs,
-                       std::vector<uint8_t>& certain, int threads, const geom::PlaneCoefficients* planes = nullptr);
+int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& topology,
+                       std::span<FacePair> pairs, std::vector<uint8_t>& certain, int threads,
+                       const geom::PlaneCoefficients* planes = nullptr);
 
 }  // namespace snag::detect

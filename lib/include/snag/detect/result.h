@@ -12,7 +12,9 @@ namespace snag::detect {
 /// plane, and they share a segment of positive length. `touching`: every other intersecting pair.
 enum class PairKind : uint8_t { crossing = 0, touching = 1 };
 
-inline std::string_view to_string(PairKind kind) { return kind == PairKind::crossing ? "crossing" : "touching"; }
+inline std::string_view to_string(PairKind kind) {
+  return kind == PairKind::crossing ? "crossing" : "touching";
+}
 
 /// An intersecting pair of triangle ids, a < b.
 struct FacePair {
@@ -24,7 +26,7 @@ struct FacePair {
 
 /// Seconds spent per stage of one frame (reading excluded).
 struct StageTimes {
-  double build = 0;     ///< tree (re)build, when one happened this frame
+  double build = 0;  ///< tree (re)build, when one happened this frame
   double refit = 0;
   double traverse = 0;  ///< traversal with the filtered narrow phase
   double exact = 0;     ///< uncertain tests decided with exact predicates
@@ -33,13 +35,13 @@ struct StageTimes {
 };
 
 struct FrameResult {
-  std::vector<FacePair> pairs;       ///< sorted by (a, b), no duplicates
-  std::vector<int32_t> degenerate;   ///< zero-area triangles, sorted; left out of the search
-  int64_t candidate_pairs = 0;       ///< pairs whose boxes overlap
-  int64_t filtered_tests = 0;        ///< orientation-based tests decided by the double filter
-  int64_t uncertain_tests = 0;       ///< tests the filter could not certify, decided exactly
-  bool rebuilt = false;              ///< the tree was (re)built for this frame
-  double tree_quality = 0;           ///< sum of internal-node half areas over the root's
+  std::vector<FacePair> pairs;      ///< sorted by (a, b), no duplicates
+  std::vector<int32_t> degenerate;  ///< zero-area triangles, sorted; left out of the search
+  int64_t candidate_pairs = 0;      ///< pairs whose boxes overlap
+  int64_t filtered_tests = 0;       ///< orientation-based tests decided by the double filter
+  int64_t uncertain_tests = 0;      ///< tests the filter could not certify, decided exactly
+  bool rebuilt = false;             ///< the tree was (re)built for this frame
+  double tree_quality = 0;          ///< sum of internal-node half areas over the root's
   StageTimes times;
 
   int64_t crossing_count() const {

@@ -49,7 +49,8 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
 
 /// The ownership masks for a frame whose degenerate triangles (sorted ids) own nothing: each
 /// edge goes to its smallest non-degenerate incident triangle.
-std::vector<uint8_t> ownership_without(const Topology& topology, std::span<const int32_t> degenerate);
+std::vector<uint8_t> ownership_without(const Topology& topology,
+                                       std::span<const int32_t> degenerate);
 
 /// Non-owning view for the narrow phase (host and device).
 struct TopologyView {

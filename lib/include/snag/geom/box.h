@@ -19,9 +19,13 @@ struct Box3f {
 
 #if defined(__CUDA_ARCH__)
 /// The largest float not above x (x finite): the conversion rounds down.
-SNAG_HD_INLINE float float_down(double x) { return __double2float_rd(x); }
+SNAG_HD_INLINE float float_down(double x) {
+  return __double2float_rd(x);
+}
 /// The smallest float not below x (x finite): the conversion rounds up.
-SNAG_HD_INLINE float float_up(double x) { return __double2float_ru(x); }
+SNAG_HD_INLINE float float_up(double x) {
+  return __double2float_ru(x);
+}
 #else
 /// The float one unit in the last place below / above finite f, by its bit pattern (the
 /// library's nextafterf is an out-of-line call in the refit's innermost loop).
@@ -45,7 +49,9 @@ inline float float_up(double x) {
 }
 #endif
 
-SNAG_HD_INLINE Box3f empty_box() { return {{FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}}; }
+SNAG_HD_INLINE Box3f empty_box() {
+  return {{FLT_MAX, FLT_MAX, FLT_MAX}, {-FLT_MAX, -FLT_MAX, -FLT_MAX}};
+}
 
 SNAG_HD_INLINE Box3f triangle_box(Vec3d a, Vec3d b, Vec3d c) {
   Box3f box;
@@ -86,7 +92,8 @@ SNAG_HD_INLINE bool contains(const Box3f& outer, const Box3f& inner) {
 
 /// Half the surface area; the tree-quality measure sums it over internal nodes.
 SNAG_HD_INLINE double half_area(const Box3f& b) {
-  double dx = double(b.hi[0]) - b.lo[0], dy = double(b.hi[1]) - b.lo[1], dz = double(b.hi[2]) - b.lo[2];
+  double dx = double(b.hi[0]) - b.lo[0], dy = double(b.hi[1]) - b.lo[1],
+         dz = double(b.hi[2]) - b.lo[2];
   return dx * dy + dy * dz + dz * dx;
 }
 

@@ -52,7 +52,8 @@ SNAG_HD_INLINE Answer all_of(Answer a, Answer b) {
   return Answer::yes;
 }
 SNAG_HD_INLINE Answer not_negative(Sign s) {
-  return s == Sign::uncertain ? Answer::uncertain : (s == Sign::negative ? Answer::no : Answer::yes);
+  return s == Sign::uncertain ? Answer::uncertain
+                              : (s == Sign::negative ? Answer::no : Answer::yes);
 }
 /// s * t <= 0.
 SNAG_HD_INLINE Answer opposite_or_zero(Sign s, Sign t) {
@@ -83,8 +84,8 @@ SNAG_HD_INLINE Sign projection(const P& pred, int32_t a, int32_t b, int32_t c, i
 
 /// Closed point-in-triangle in the projection along `axis`; `orientation` is orient2d(a, b, c).
 template <class P>
-SNAG_HD_INLINE Answer point_in_triangle_2d(const P& pred, int32_t p, int32_t a, int32_t b, int32_t c, int axis,
-                                           Sign orientation) {
+SNAG_HD_INLINE Answer point_in_triangle_2d(const P& pred, int32_t p, int32_t a, int32_t b,
+                                           int32_t c, int axis, Sign orientation) {
   Answer inside = not_negative(times(pred.orient2d(a, b, p, axis), orientation));
   if (inside == Answer::no) return inside;
   inside = all_of(inside, not_negative(times(pred.orient2d(b, c, p, axis), orientation)));
@@ -97,7 +98,8 @@ SNAG_HD_INLINE Answer point_in_triangle_2d(const P& pred, int32_t p, int32_t a, 
 /// strictly inside pq, and that is found as a proper crossing of the triangle's other edge
 /// through that vertex, so collinear pairs answer `no` here.
 template <class P>
-SNAG_HD_INLINE Answer segments_meet_2d(const P& pred, int32_t p, int32_t q, int32_t x, int32_t y, int axis) {
+SNAG_HD_INLINE Answer segments_meet_2d(const P& pred, int32_t p, int32_t q, int32_t x, int32_t y,
+                                       int axis) {
   const Sign o1 = pred.orient2d(p, q, x, axis), o2 = pred.orient2d(p, q, y, axis);
   if (o1 == Sign::zero && o2 == Sign::zero) return Answer::no;
   const Answer straddles_pq = opposite_or_zero(o1, o2);
@@ -110,9 +112,11 @@ SNAG_HD_INLINE Answer segments_meet_2d(const P& pred, int32_t p, int32_t q, int3
 /// `sp`, `sq`: the sides of p and q w.r.t. t's plane (orient3d(a, b, c, .)), zero where the
 /// endpoint is a vertex of t. Preconditions: t is not degenerate, pq is not an edge of t.
 template <class P>
-SNAG_HD Answer edge_hits_triangle(const P& pred, int32_t p, int32_t q, const Tri& t, Sign sp, Sign sq) {
+SNAG_HD Answer edge_hits_triangle(const P& pred, int32_t p, int32_t q, const Tri& t, Sign sp,
+                                  Sign sq) {
   // Both endpoints strictly on one side: no contact.
-  if ((sp == Sign::positive && sq == Sign::positive) || (sp == Sign::negative && sq == Sign::negative))
+  if ((sp == Sign::positive && sq == Sign::positive) ||
+      (sp == Sign::negative && sq == Sign::negative))
     return Answer::no;
   const int32_t a = t.v[0], b = t.v[1], c = t.v[2];
   const bool p_shared = p == a || p == b || p == c;
@@ -131,9 +135,11 @@ SNAG_HD Answer edge_hits_triangle(const P& pred, int32_t p, int32_t q, const Tri
     int axis = 0;
     const Sign orientation = projection(pred, a, b, c, axis);
     if (orientation == Sign::uncertain) return Answer::uncertain;
-    const Answer after_next = not_negative(times(pred.orient2d(s, s_next, other, axis), orientation));
+    const Answer after_next =
+        not_negative(times(pred.orient2d(s, s_next, other, axis), orientation));
     if (after_next == Answer::no) return Answer::no;
-    return all_of(after_next, not_negative(times(pred.orient2d(s, other, s_prev, axis), orientation)));
+    return all_of(after_next,
+                  not_negative(times(pred.orient2d(s, other, s_prev, axis), orientation)));
   }
   if (sp == Sign::uncertain || sq == Sign::uncertain) return Answer::uncertain;
   if (sp == Sign::zero && sq == Sign::zero) {
@@ -161,7 +167,8 @@ SNAG_HD Answer edge_hits_triangle(const P& pred, int32_t p, int32_t q, const Tri
   const bool has_positive = e0 == Sign::positive || e1 == Sign::positive || e2 == Sign::positive;
   const bool has_negative = e0 == Sign::negative || e1 == Sign::negative || e2 == Sign::negative;
   if (has_positive && has_negative) return Answer::no;
-  if (e0 == Sign::uncertain || e1 == Sign::uncertain || e2 == Sign::uncertain) return Answer::uncertain;
+  if (e0 == Sign::uncertain || e1 == Sign::uncertain || e2 == Sign::uncertain)
+    return Answer::uncertain;
   return Answer::yes;
 }
 
@@ -179,7 +186,8 @@ SNAG_HD_INLINE Answer is_degenerate(const P& pred, int32_t a, int32_t b, int32_t
   return degenerate;
 }
 
-/// The sides of triangle f's corners w.r.t. triangle x's plane; zero where a corner is a vertex of x.
+/// The sides of triangle f's corners w.r.t. triangle x's plane; zero where a corner is a vertex of
+/// x.
 template <class P>
 SNAG_HD_INLINE void corner_sides(const P& pred, const Tri& f, const Tri& x, Sign side[3]) {
   const auto plane = pred.plane(x.v[0], x.v[1], x.v[2]);
@@ -215,7 +223,8 @@ SNAG_HD_INLINE int lone_corner(const Sign side[3]) {
 /// some Jj < some Ii: among the four signs there is a positive and a negative one.
 /// sf: the sides of f's corners w.r.t. x's plane; sx: of x's w.r.t. f's (zero where shared).
 template <class P>
-SNAG_HD Answer is_crossing_given_sides(const P& pred, const Tri& f, const Tri& x, const Sign sf[3], const Sign sx[3]) {
+SNAG_HD Answer is_crossing_given_sides(const P& pred, const Tri& f, const Tri& x, const Sign sf[3],
+                                       const Sign sx[3]) {
   for (int i = 0; i < 3; ++i)
     if (sf[i] == Sign::uncertain || sx[i] == Sign::uncertain) return Answer::uncertain;
   const int fi = lone_corner(sf), xi = lone_corner(sx);

@@ -36,9 +36,13 @@ constexpr double kMinPermanent = 0x1p-900;
 // A difference this large or exactly zero keeps every product of three of them normal.
 constexpr double kMinDifference = 0x1p-300;
 
-SNAG_HD_INLINE bool safe_difference(double d) { return d == 0.0 || fabs(d) >= kMinDifference; }
+SNAG_HD_INLINE bool safe_difference(double d) {
+  return d == 0.0 || fabs(d) >= kMinDifference;
+}
 
-SNAG_HD_INLINE Sign sign_of(double det) { return det > 0 ? Sign::positive : Sign::negative; }
+SNAG_HD_INLINE Sign sign_of(double det) {
+  return det > 0 ? Sign::positive : Sign::negative;
+}
 }  // namespace detail
 
 /// Sign of det[(ax - cx, ay - cy), (bx - cx, by - cy)] for 2D points given by coordinates.
@@ -58,9 +62,16 @@ SNAG_HD_INLINE Sign orient2d(double ax, double ay, double bx, double by, double 
 /// 1 keeps z, x; 2 keeps x, y), so that orient2d of a projected triangle has the sign of its
 /// normal's `axis` component.
 SNAG_HD_INLINE void project(Vec3d p, int axis, double& u, double& v) {
-  if (axis == 0) { u = p.y; v = p.z; }
-  else if (axis == 1) { u = p.z; v = p.x; }
-  else { u = p.x; v = p.y; }
+  if (axis == 0) {
+    u = p.y;
+    v = p.z;
+  } else if (axis == 1) {
+    u = p.z;
+    v = p.x;
+  } else {
+    u = p.x;
+    v = p.y;
+  }
 }
 
 SNAG_HD_INLINE Sign orient2d(Vec3d a, Vec3d b, Vec3d c, int axis) {
@@ -86,7 +97,8 @@ struct PlaneCoefficients {
   SNAG_HD_INLINE static PlaneCoefficients of(Vec3d a, Vec3d b, Vec3d c) {
     const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
     const double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
-    const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy, uyvx = uy * vx;
+    const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy,
+                 uyvx = uy * vx;
     return {{uyvz - uzvy, uzvx - uxvz, uxvy - uyvx},
             {fabs(uyvz) + fabs(uzvy), fabs(uzvx) + fabs(uxvz), fabs(uxvy) + fabs(uyvx)}};
   }
@@ -98,20 +110,24 @@ namespace detail {
 /// unless a product underflowed to zero.
 SNAG_HD inline Sign plane_side_rare(Vec3d a, Vec3d b, Vec3d c, Vec3d d, double perm) {
   if (d == a || d == b || d == c) return Sign::zero;
-  if (perm == 0.0 && safe_difference(d.x - a.x) && safe_difference(d.y - a.y) && safe_difference(d.z - a.z) &&
-      safe_difference(b.x - a.x) && safe_difference(b.y - a.y) && safe_difference(b.z - a.z) &&
-      safe_difference(c.x - a.x) && safe_difference(c.y - a.y) && safe_difference(c.z - a.z))
+  if (perm == 0.0 && safe_difference(d.x - a.x) && safe_difference(d.y - a.y) &&
+      safe_difference(d.z - a.z) && safe_difference(b.x - a.x) && safe_difference(b.y - a.y) &&
+      safe_difference(b.z - a.z) && safe_difference(c.x - a.x) && safe_difference(c.y - a.y) &&
+      safe_difference(c.z - a.z))
     return Sign::zero;
   return Sign::uncertain;
 }
 }  // namespace detail
 
-/// Sign of det[b - a, c - a, d - a] from the plane's coefficients (k = PlaneCoefficients::of(a, b, c)).
+/// Sign of det[b - a, c - a, d - a] from the plane's coefficients (k = PlaneCoefficients::of(a, b,
+/// c)).
 SNAG_HD_INLINE Sign plane_side(const PlaneCoefficients& k, Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
   const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
   const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
-  const double perm = fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
-  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm) return detail::sign_of(det);
+  const double perm =
+      fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
+  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm)
+    return detail::sign_of(det);
   return detail::plane_side_rare(a, b, c, d, perm);
 }
 

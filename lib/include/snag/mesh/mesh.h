@@ -16,11 +16,11 @@ namespace snag::mesh {
 struct Mesh {
   std::vector<geom::Vec3d> positions;
   std::vector<geom::Tri> triangles;
-  std::vector<int32_t> source_polygon;  ///< per triangle: the file's face (polygon) id
-  std::vector<int32_t> triangle_group;  ///< per triangle: index into group_names, or -1
-  std::vector<std::string> group_names; ///< OBJ `o`/`g` names in order of first use
-  int64_t polygon_count = 0;            ///< faces as listed in the file
-  bool ids_from_assimp = false;         ///< true when ids are assimp's, not the file's
+  std::vector<int32_t> source_polygon;   ///< per triangle: the file's face (polygon) id
+  std::vector<int32_t> triangle_group;   ///< per triangle: index into group_names, or -1
+  std::vector<std::string> group_names;  ///< OBJ `o`/`g` names in order of first use
+  int64_t polygon_count = 0;             ///< faces as listed in the file
+  bool ids_from_assimp = false;          ///< true when ids are assimp's, not the file's
 };
 
 /// Non-owning view passed by value into kernels and OpenMP loops alike.
@@ -31,7 +31,8 @@ struct MeshView {
   int32_t triangle_count = 0;
 };
 
-inline MeshView view_of(const std::vector<geom::Vec3d>& positions, const std::vector<geom::Tri>& triangles) {
+inline MeshView view_of(const std::vector<geom::Vec3d>& positions,
+                        const std::vector<geom::Tri>& triangles) {
   return {positions.data(), triangles.data(), static_cast<int32_t>(positions.size()),
           static_cast<int32_t>(triangles.size())};
 }

@@ -17,8 +17,8 @@ namespace snag::validators {
 /// the triangles' shared vertices taken from their ids. Zero-area triangles are left out
 /// (snag reports them apart). Throws snag::InternalError when the triangles do not form a
 /// mesh CGAL's halfedge structure can hold; then use `cgal_soup_self_intersections`.
-std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(std::span<const geom::Vec3d> positions,
-                                                                 std::span<const geom::Tri> triangles);
+std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(
+    std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
 
 /// CGAL's self_intersections over a sequence that keeps one topology: the halfedge mesh is
 /// built once and only its points change per frame, so a benchmark times CGAL's own work and
@@ -46,7 +46,7 @@ class CgalSequence {
 /// opposite edge of one meets the other; else CGAL::do_intersect) decided pair by pair with
 /// CGAL's predicates over CGAL's box intersection, with shared vertices taken from ids. Works
 /// on any triangle soup, including non-manifold ones.
-std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(std::span<const geom::Vec3d> positions,
-                                                                      std::span<const geom::Tri> triangles);
+std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
+    std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
 
 }  // namespace snag::validators
