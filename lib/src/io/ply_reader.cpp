@@ -364,45 +364,32 @@ class BinaryBody {
     if constexpr (Swap) v = __builtin_bswap64(v);
     return v;
   }
-  static double load_double(const char* p, Scalar t) {
+  /// A binary value of type `t` as a T: double for coordinates, int64_t for counts and
+  /// indices (make_plan admits only integer types there, so the float cases never reach it).
+  template <class T>
+  static T load_as(const char* p, Scalar t) {
     switch (t) {
       case Scalar::i8:
-        return static_cast<int8_t>(*p);
+        return static_cast<T>(static_cast<int8_t>(*p));
       case Scalar::u8:
-        return static_cast<uint8_t>(*p);
+        return static_cast<T>(static_cast<uint8_t>(*p));
       case Scalar::i16:
-        return static_cast<int16_t>(load16(p));
+        return static_cast<T>(static_cast<int16_t>(load16(p)));
       case Scalar::u16:
-        return load16(p);
+        return static_cast<T>(load16(p));
       case Scalar::i32:
-        return static_cast<int32_t>(load32(p));
+        return static_cast<T>(static_cast<int32_t>(load32(p)));
       case Scalar::u32:
-        return load32(p);
+        return static_cast<T>(load32(p));
       case Scalar::f32:
-        return std::bit_cast<float>(load32(p));
+        return static_cast<T>(std::bit_cast<float>(load32(p)));
       case Scalar::f64:
-        return std::bit_cast<double>(load64(p));
+        return static_cast<T>(std::bit_cast<double>(load64(p)));
     }
-    return 0;
+    return T{};
   }
-  static int64_t load_int(const char* p, Scalar t) {
-    switch (t) {
-      case Scalar::i8:
-        return static_cast<int8_t>(*p);
-      case Scalar::u8:
-        return static_cast<uint8_t>(*p);
-      case Scalar::i16:
-        return static_cast<int16_t>(load16(p));
-      case Scalar::u16:
-        return load16(p);
-      case Scalar::i32:
-        return static_cast<int32_t>(load32(p));
-      case Scalar::u32:
-        return load32(p);
-      default:
-        return 0;  // excluded by make_plan: counts and indices are integer types
-    }
-  }
+  static double load_double(const char* p, Scalar t) { return load_as<double>(p, t); }
+  static int64_t load_int(const char* p, Scalar t) { return load_as<int64_t>(p, t); }
 
   void read_vertices(const Element& el) {
     const int64_t min_bytes = el.min_record_bytes();
