@@ -9,7 +9,7 @@ DEMO_REPORT := $(BUILD)/demo-report
 
 # Everything the build and the tests need, as Debian 12 packages.
 DEBIAN_PACKAGES := cmake g++ make libcgal-dev libassimp-dev libeigen3-dev libcli11-dev \
-  nlohmann-json3-dev libfast-float-dev libtbb-dev libgtest-dev libgmock-dev googletest \
+  nlohmann-json3-dev libfast-float-dev libgtest-dev libgmock-dev googletest \
   libmpfr-dev libgmp-dev
 # apt-get needs root; use sudo when make runs as another user.
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
