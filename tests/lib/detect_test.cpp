@@ -3,9 +3,11 @@
 // against rebuild.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "detect_cases.h"
+#include "snag/detect/topology.h"
 
 namespace snag::test {
 namespace {
@@ -82,6 +84,37 @@ TEST(Detect, TopologyChangeRebuilds) {
   const detect::FrameResult result = checker.check(mesh.positions);
   EXPECT_TRUE(result.rebuilt);
   EXPECT_EQ(result.pairs, brute_force(mesh));
+}
+
+TEST(Detect, FansAboveTheListedValenceAreFoundByTheTraversal) {
+  // A fan of 48 triangles winding twice around its centre, corners alternately above and below
+  // the plane: its triangles intersect each other, the centre has valence 48 > 32, so those
+  // pairs are not in the neighbour list and must come from the traversal, each exactly once.
+  // A second fan of 8 (listed) shares a rim vertex with it.
+  SmallMesh mesh;
+  mesh.positions.push_back({0, 0, 0});
+  const int rim = 48;
+  for (int i = 0; i < rim; ++i) {
+    const double angle = 4.0 * 3.14159265358979 * i / rim;  // two turns
+    mesh.positions.push_back(
+        {std::round(100 * std::cos(angle)), std::round(100 * std::sin(angle)), i % 2 ? 7.0 : -5.0});
+  }
+  for (int i = 0; i < rim; ++i) mesh.triangles.push_back({{0, 1 + i, 1 + (i + 1) % rim}});
+  const int32_t hub = static_cast<int32_t>(mesh.positions.size());
+  mesh.positions.push_back({100, 0, 30});
+  for (int i = 0; i < 8; ++i) {
+    const int32_t a = static_cast<int32_t>(mesh.positions.size());
+    mesh.positions.push_back({100.0 + 40 * (i % 3) - 40, 40.0 * (i / 3) - 40, -20.0 + 9 * i});
+    mesh.triangles.push_back({{hub, a, i == 0 ? 1 : a - 1}});
+  }
+  const detect::Topology topology =
+      detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  ASSERT_FALSE(topology.every_vertex_listed);
+  ASSERT_FALSE(topology.listed_vertex[0]);
+  const std::vector<detect::FacePair> expected = brute_force(mesh);
+  ASSERT_GT(expected.size(), 20u);
+  for (int threads : {1, 2})
+    EXPECT_EQ(check_mesh(mesh, threads).pairs, expected) << threads << " threads";
 }
 
 TEST(Detect, EmptyAndSingleTriangleMeshes) {
