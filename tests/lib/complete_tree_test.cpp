@@ -169,6 +169,41 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   }
 }
 
+TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
+  // Coordinates past FLT_MAX (finite doubles) give leaf boxes of +-FLT_MAX or infinity, which
+  // also "overlap" an empty box: lanes without a member must still never be visited.
+  for (int32_t n : {2, 3, 5, 6, 7, 11}) {
+    Soup soup;
+    for (int32_t t = 0; t < n; ++t) {
+      const double s = 4e38 + t * 1e37;
+      soup.positions.push_back({-s, -s, -s});
+      soup.positions.push_back({s, s, s});
+      soup.positions.push_back({s, -s, double(t)});
+      soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+    }
+    Tree tree;
+    tree.build(soup.view(), 1);
+    const TreeView view = tree.view();
+    std::multiset<std::pair<int32_t, int32_t>> per_leaf, grouped;
+    for (int32_t p = 0; p < n; ++p) {
+      const int32_t t = view.triangle_at[p];
+      for_each_later_overlap(view, p, [&](int32_t x) {
+        per_leaf.insert({std::min(t, x), std::max(t, x)});
+      });
+    }
+    const int32_t level = group_level(view.shape);
+    for (int32_t group = CompleteTree::level_begin(level);
+         group < std::min(CompleteTree::level_begin(level + 1), view.shape.node_count()); ++group)
+      for_each_later_overlap_grouped(view, group, [&](int32_t t, int32_t x) {
+        ASSERT_GE(t, 0) << "n=" << n;
+        ASSERT_GE(x, 0) << "n=" << n;
+        grouped.insert({std::min(t, x), std::max(t, x)});
+      });
+    EXPECT_EQ(grouped, per_leaf) << "n=" << n;
+    EXPECT_EQ(per_leaf.size(), static_cast<size_t>(n * (n - 1) / 2)) << "n=" << n;
+  }
+}
+
 TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
   for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 100, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {

@@ -68,6 +68,21 @@ TEST(Predicates, FilterNeverGivesAWrongSignOnSmallIntegers) {
   (void)uncertain;
 }
 
+TEST(Predicates, AnUnderflowedMinorIsNeverCertified) {
+  // A minor of the plane underflows (2^-1080) and is then multiplied by 2^500: the computed
+  // determinant is negative while the exact one, 2^-580 - 2^-601, is positive. The filter must
+  // answer `uncertain` (or the right sign), never `negative`.
+  const geom::Vec3d a{0, 0, 0}, b{0x1p-61, 0x1p-540, 0}, c{0, 0, 0x1p-540}, d{0x1p500, 1, 0};
+  EXPECT_NE(geom::orient3d(a, b, c, d), geom::Sign::negative);
+  EXPECT_EQ(geom::orient3d(a, b, c, d), geom::Sign::uncertain);
+  // A tiny query difference against an ordinary plane is likewise left to exact arithmetic.
+  EXPECT_EQ(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0x1p-600, 0x1p-600, 0x1p-600}),
+            geom::Sign::uncertain);
+  // Ordinary inputs stay certain.
+  EXPECT_EQ(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.25, 0.5, 1e-9}),
+            geom::Sign::positive);
+}
+
 TEST(Predicates, NearDegenerateSignsAreUncertainNotWrong) {
   // d moved off the plane of a, b, c by one unit in the last place: tiny determinants whose
   // sign the double evaluation can get wrong; the filter must certify only correct ones.

@@ -137,6 +137,10 @@ inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&&
       hi[k][lane] = box.hi[k];
     }
   }
+  // Lanes without a member: their empty box is not enough, since a leaf box that reaches
+  // +-FLT_MAX on every axis (coordinates beyond the float range) overlaps it.
+  const LaneMask present = {members > 0 ? -1 : 0, members > 1 ? -1 : 0, members > 2 ? -1 : 0,
+                            members > 3 ? -1 : 0};
   // Pairs of members.
   for (int a = 0; a < members; ++a)
     for (int b = a + 1; b < members; ++b) {
@@ -153,7 +157,8 @@ inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&&
     while (true) {
       const geom::Box3f& box = tree.boxes[i];
       const LaneMask overlaps = (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
-                                (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]);
+                                (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) &
+                                present;
       const bool hit = (overlaps[0] | overlaps[1] | overlaps[2] | overlaps[3]) != 0;
       const bool internal = i < first_leaf;
       if (hit & !internal) {

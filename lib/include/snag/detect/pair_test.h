@@ -114,13 +114,9 @@ SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions,
       continue;
     }
     const geom::Vec3d d = positions[t.v[i]];
-    const double wx = d.x - origin.x, wy = d.y - origin.y, wz = d.z - origin.z;
-    const double det = wx * plane.minor[0] + wy * plane.minor[1] + wz * plane.minor[2];
-    const double perm = fabs(wx) * plane.permanent[0] + fabs(wy) * plane.permanent[1] +
-                        fabs(wz) * plane.permanent[2];
-    if (perm >= geom::detail::kMinPermanent && fabs(det) > geom::detail::kOrient3dBound * perm)
-      side[i] = det > 0 ? geom::Sign::positive : geom::Sign::negative;
-    else
+    double perm;
+    side[i] = geom::plane_side_filter(plane, origin, d, perm);
+    if (side[i] == geom::Sign::uncertain)
       side[i] =
           geom::detail::plane_side_rare(origin, positions[x.v[1]], positions[x.v[2]], d, perm);
   }

@@ -91,16 +91,25 @@ SNAG_HD_INLINE Sign orient2d(Vec3d a, Vec3d b, Vec3d c, int axis) {
 /// third, which is exactly the form of Shewchuk's orient3d (his rows are a - d, b - d, c - d),
 /// so his bound o3derrboundA times the permanent sum_k |w_k| (|u_i v_j| + |u_j v_i|) holds.
 struct PlaneCoefficients {
-  double minor[3];      ///< (u x v)_k, each rounded
-  double permanent[3];  ///< |u_i v_j| + |u_j v_i| for the same k
+  double minor[3];  ///< (u x v)_k, each rounded
+  /// |u_i v_j| + |u_j v_i| for the same k; NaN when a difference of u or v is nonzero but so
+  /// small that a product may underflow, which makes every query through the plane uncertain
+  /// (an underflowed minor times a large w_k can exceed any relative bound).
+  double permanent[3];
 
   SNAG_HD_INLINE static PlaneCoefficients of(Vec3d a, Vec3d b, Vec3d c) {
     const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
     const double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
     const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy,
                  uyvx = uy * vx;
-    return {{uyvz - uzvy, uzvx - uxvz, uxvy - uyvx},
-            {fabs(uyvz) + fabs(uzvy), fabs(uzvx) + fabs(uxvz), fabs(uxvy) + fabs(uyvx)}};
+    PlaneCoefficients k{
+        {uyvz - uzvy, uzvx - uxvz, uxvy - uyvx},
+        {fabs(uyvz) + fabs(uzvy), fabs(uzvx) + fabs(uxvz), fabs(uxvy) + fabs(uyvx)}};
+    using detail::safe_difference;
+    if (!(safe_difference(ux) && safe_difference(uy) && safe_difference(uz) &&
+          safe_difference(vx) && safe_difference(vy) && safe_difference(vz)))
+      k.permanent[0] = NAN;
+    return k;
   }
 };
 
@@ -119,16 +128,26 @@ SNAG_HD inline Sign plane_side_rare(Vec3d a, Vec3d b, Vec3d c, Vec3d d, double p
 }
 }  // namespace detail
 
+/// The filter part of plane_side: the sign of det[b - a, c - a, d - a] when the bound certifies
+/// it (every difference zero or far from underflow, so no product underflowed), else
+/// Sign::uncertain; `perm` receives the permanent for plane_side_rare.
+SNAG_HD_INLINE Sign plane_side_filter(const PlaneCoefficients& k, Vec3d a, Vec3d d, double& perm) {
+  const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
+  const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
+  perm = fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
+  using detail::safe_difference;
+  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm &&
+      safe_difference(wx) && safe_difference(wy) && safe_difference(wz))
+    return detail::sign_of(det);
+  return Sign::uncertain;
+}
+
 /// Sign of det[b - a, c - a, d - a] from the plane's coefficients (k = PlaneCoefficients::of(a, b,
 /// c)).
 SNAG_HD_INLINE Sign plane_side(const PlaneCoefficients& k, Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
-  const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
-  const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
-  const double perm =
-      fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
-  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm)
-    return detail::sign_of(det);
-  return detail::plane_side_rare(a, b, c, d, perm);
+  double perm;
+  const Sign sign = plane_side_filter(k, a, d, perm);
+  return sign != Sign::uncertain ? sign : detail::plane_side_rare(a, b, c, d, perm);
 }
 
 /// Sign of det[b - a, c - a, d - a]; bit for bit what plane_side answers.
