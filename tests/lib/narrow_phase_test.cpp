@@ -75,9 +75,14 @@ TEST(Predicates, AnUnderflowedMinorIsNeverCertified) {
   const geom::Vec3d a{0, 0, 0}, b{0x1p-61, 0x1p-540, 0}, c{0, 0, 0x1p-540}, d{0x1p500, 1, 0};
   EXPECT_NE(geom::orient3d(a, b, c, d), geom::Sign::negative);
   EXPECT_EQ(geom::orient3d(a, b, c, d), geom::Sign::uncertain);
-  // A tiny query difference against an ordinary plane is likewise left to exact arithmetic.
+  // Tiny query differences against an ordinary plane: products near or below the underflow
+  // threshold, whose signs must still be right when certified.
   EXPECT_EQ(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0x1p-600, 0x1p-600, 0x1p-600}),
-            geom::Sign::uncertain);
+            geom::Sign::positive);
+  EXPECT_NE(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0x1p-1074, 1, 0x1p-1074}),
+            geom::Sign::negative);
+  EXPECT_NE(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, -0x1p-1074}),
+            geom::Sign::positive);
   // Ordinary inputs stay certain.
   EXPECT_EQ(geom::orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.25, 0.5, 1e-9}),
             geom::Sign::positive);

@@ -33,6 +33,9 @@ constexpr double kOrient2dBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 // Below this permanent, products may have underflowed and the relative bound no longer holds.
 constexpr double kMinPermanent = 0x1p-900;
+// About twenty times the largest error (3 * 2^-1075) that underflow in the three final products
+// of a query can add to its determinant and its permanent.
+constexpr double kUnderflowSlack = 0x1p-1069;
 // A difference this large or exactly zero keeps every product of three of them normal.
 constexpr double kMinDifference = 0x1p-300;
 
@@ -129,15 +132,16 @@ SNAG_HD inline Sign plane_side_rare(Vec3d a, Vec3d b, Vec3d c, Vec3d d, double p
 }  // namespace detail
 
 /// The filter part of plane_side: the sign of det[b - a, c - a, d - a] when the bound certifies
-/// it (every difference zero or far from underflow, so no product underflowed), else
-/// Sign::uncertain; `perm` receives the permanent for plane_side_rare.
+/// it, else Sign::uncertain; `perm` receives the permanent for plane_side_rare. The plane's
+/// products cannot underflow (PlaneCoefficients::of makes such a plane's queries uncertain);
+/// the query's three products w_k * minor_k can, by at most 2^-1075 each, which the absolute
+/// term kUnderflowSlack covers.
 SNAG_HD_INLINE Sign plane_side_filter(const PlaneCoefficients& k, Vec3d a, Vec3d d, double& perm) {
   const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
   const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
   perm = fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
-  using detail::safe_difference;
-  if (perm >= detail::kMinPermanent && fabs(det) > detail::kOrient3dBound * perm &&
-      safe_difference(wx) && safe_difference(wy) && safe_difference(wz))
+  if (perm >= detail::kMinPermanent &&
+      fabs(det) > detail::kOrient3dBound * perm + detail::kUnderflowSlack)
     return detail::sign_of(det);
   return Sign::uncertain;
 }
