@@ -191,8 +191,6 @@ class Tree {
   double quality() const;
 
   TreeView view() { return {shape_, boxes_.data(), triangle_at_.data()}; }
-  /// The inverse of triangle_at: the leaf node of each triangle.
-  const std::vector<int32_t>& leaf_of_triangle() const { return leaf_of_triangle_; }
   const CompleteTree& shape() const { return shape_; }
   const std::vector<geom::Box3f>& boxes() const { return boxes_; }
   const std::vector<int32_t>& triangle_at() const { return triangle_at_; }
@@ -201,7 +199,7 @@ class Tree {
   CompleteTree shape_;
   std::vector<geom::Box3f> boxes_;
   std::vector<int32_t> triangle_at_;
-  std::vector<int32_t> leaf_of_triangle_;
+  std::vector<int32_t> leaf_of_triangle_;  ///< the inverse of triangle_at_: each triangle's leaf
 };
 
 }  // namespace snag::bvh

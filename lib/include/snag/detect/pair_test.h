@@ -10,10 +10,6 @@
 
 namespace snag::detect {
 
-SNAG_HD_INLINE bool is_corner_of(int32_t v, const geom::Tri& x) {
-  return v == x.v[0] || v == x.v[1] || v == x.v[2];
-}
-
 /// Whether the pair is tested by the neighbour pass (it shares a listed vertex, see
 /// Topology::neighbor_pairs) rather than from the traversal.
 SNAG_HD_INLINE bool is_listed_neighbor(const geom::Tri& t, const geom::Tri& x,
