@@ -20,7 +20,7 @@
 #include "snag/report/report.h"
 #include "snag/report/write.h"
 #include "snag/seq/sequence.h"
-#include "snag/validators/cgal_resolver.h"
+#include "snag/validators/exact_modes.h"
 
 namespace snag::cli {
 
@@ -166,6 +166,14 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("WHAT")
       ->check(CLI::IsMember({"crossing", "any", "none"}))
       ->capture_default_str();
+  cmd->add_option("--exact", o.exact,
+                  "How signs are decided: off (the double filter decides all, even where its "
+                  "error bound cannot; fast, may be wrong on degenerate input), uncertain (what "
+                  "the filter cannot certify goes to CGAL's exact predicates), all (everything "
+                  "exactly, every pair confirmed by CGAL's own triangle tests)")
+      ->type_name("MODE")
+      ->check(CLI::IsMember({"off", "uncertain", "all"}))
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", o.quiet, "No progress and no warnings on standard error");
   return cmd;
 }
@@ -176,6 +184,8 @@ int run_check(const CheckOptions& o) {
   if (!fail_on)
     throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
   if (o.weld && !(*o.weld >= 0)) throw UsageError("--weld: TOL must be a number >= 0");
+  const auto exact = detect::parse_exact_mode(o.exact);
+  if (!exact) throw UsageError("--exact: expected off, uncertain or all, got '" + o.exact + "'");
 
   const std::vector<seq::Frame> frames = resolve_frames(o);
   // The output directory is checked before the first frame, so an unusable --out fails at
@@ -187,14 +197,17 @@ int run_check(const CheckOptions& o) {
   detect::CheckSettings settings;
   settings.rebuild = rebuild_policy(o.rebuild);
   settings.rebuild_threshold = o.rebuild_threshold;
-  detect::Checker checker(std::move(backend), validators::make_cgal_resolver(), settings);
+  settings.exact = *exact;
+  const std::unique_ptr<detect::Checker> checker =
+      validators::make_checker(std::move(backend), settings);
 
   report::Report rep;
   rep.snag_version = SNAG_VERSION;
   rep.settings.backend = backend_name;
   rep.settings.backend_requested = o.backend;
   rep.settings.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-  rep.settings.exact = "cgal";
+  rep.settings.exact = std::string(detect::to_string(*exact));
+  rep.settings.exact_predicates = *exact == detect::ExactMode::off ? "rounded" : "cgal";
   rep.settings.weld = o.weld;
   rep.settings.rebuild = o.rebuild;
   rep.settings.rebuild_threshold = o.rebuild_threshold;
@@ -250,11 +263,11 @@ int run_check(const CheckOptions& o) {
                            "unwelded seams are reported as intersections (use --weld TOL)");
       }
       file_triangles = mesh.triangles;
-      checker.set_triangles(welded_triangles(mesh, representative), vertex_count);
+      checker->set_triangles(welded_triangles(mesh, representative), vertex_count);
     }
     const double read_seconds = seconds_since(read_started);
 
-    const detect::FrameResult result = checker.check(mesh.positions);
+    const detect::FrameResult result = checker->check(mesh.positions);
     report::FrameRecord record = report::make_frame_record(
         frame.number, file, result, mesh.source_polygon, vertices, mesh.polygon_count);
     record.topology_changed = topology_changed;
@@ -265,8 +278,8 @@ int run_check(const CheckOptions& o) {
   progress.finish();
 
   rep.inputs.ids = any_assimp ? "assimp" : "file";
-  rep.builds = checker.build_count();
-  rep.rebuilds = checker.rebuild_count();
+  rep.builds = checker->build_count();
+  rep.rebuilds = checker->rebuild_count();
   rep.wall_seconds = seconds_since(started);
   const report::Summary summary = report::summarize(rep);
 

@@ -23,6 +23,7 @@ struct CheckOptions {
   int device = 0;
   int threads = 0;
   std::string fail_on = "crossing";
+  std::string exact = "uncertain";
   bool quiet = false;
 };
 

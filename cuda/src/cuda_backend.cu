@@ -249,7 +249,8 @@ class CudaBackendImpl final : public CudaBackend {
     return boxes;
   }
 
-  detect::FilteredFrame detect(std::span<const int32_t> degenerate) override;
+  detect::FilteredFrame detect(std::span<const int32_t> degenerate,
+                               detect::FilterUse use) override;
 
  private:
   cudaStream_t stream() const { return stream_->get(); }
@@ -365,7 +366,8 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
   return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
 }
 
-detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerate) {
+detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerate,
+                                              detect::FilterUse use) {
   require_topology();
   detect::FilteredFrame frame;
   const int32_t n = topo_.triangle_count;
@@ -417,7 +419,8 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     SNAG_CUDA_CHECK(
         cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
     launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(),
-                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, s);
+                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, use,
+                        s);
     narrow_timer_.stop_async(s);
     launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
                   counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),

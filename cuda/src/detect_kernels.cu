@@ -87,6 +87,7 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
 }
 
 /// One thread's share of the neighbour pass: listed pair i (their boxes always overlap).
+template <detect::FilterUse use>
 __device__ __forceinline__ void neighbor_pair(const PairInputs& in,
                                               const std::array<int32_t, 2>* pairs,
                                               const uint8_t* shared_masks, int64_t i,
@@ -95,11 +96,12 @@ __device__ __forceinline__ void neighbor_pair(const PairInputs& in,
   if (in.degenerate[t] || in.degenerate[x]) return;
   ++candidates;
   const uint32_t shared = shared_masks[i];
-  detect::test_pair_given_shared(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
+  detect::test_pair<use>(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
 }
 
 /// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
 /// neighbours and follow nearly the same path; pairs of the neighbour list are skipped.
+template <detect::FilterUse use>
 __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const PairInputs& in,
                                               int32_t position, DeviceSink& sink,
                                               unsigned long long& candidates) {
@@ -112,12 +114,13 @@ __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const P
                                    in.topology.every_vertex_listed))
       return;
     ++candidates;
-    detect::test_candidate_pair(in.frame, in.topology, t, x, sink);
+    detect::test_candidate_pair<use>(in.frame, in.topology, t, x, sink);
   });
 }
 
 /// Blocks [0, traverse_blocks) traverse, the rest run the neighbour pass (the branch is uniform
 /// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
+template <detect::FilterUse use>
 __global__ void __launch_bounds__(kNarrowBlock)
     narrow_phase_kernel(bvh::TreeView tree, PairInputs in, const std::array<int32_t, 2>* pairs,
                         const uint8_t* shared_masks, int64_t pair_count, unsigned traverse_blocks,
@@ -126,10 +129,11 @@ __global__ void __launch_bounds__(kNarrowBlock)
   unsigned long long candidates = 0;
   if (blockIdx.x < traverse_blocks) {
     const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-    if (position < tree.shape.leaf_count) traverse_leaf(tree, in, position, sink, candidates);
+    if (position < tree.shape.leaf_count)
+      traverse_leaf<use>(tree, in, position, sink, candidates);
   } else {
     const int64_t i = static_cast<int64_t>(blockIdx.x - traverse_blocks) * blockDim.x + threadIdx.x;
-    if (i < pair_count) neighbor_pair(in, pairs, shared_masks, i, sink, candidates);
+    if (i < pair_count) neighbor_pair<use>(in, pairs, shared_masks, i, sink, candidates);
   }
   add_warp_total(candidates, &out.counters->candidates);
   add_warp_total(sink.misses, &out.counters->misses);
@@ -265,11 +269,15 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs,
                          const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, cudaStream_t stream) {
+                         const ResultBuffers& results, detect::FilterUse use,
+                         cudaStream_t stream) {
   const int64_t traverse_blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
   const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
   if (blocks == 0) return;
-  narrow_phase_kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
+  const auto kernel = use == detect::FilterUse::certify
+                          ? narrow_phase_kernel<detect::FilterUse::certify>
+                          : narrow_phase_kernel<detect::FilterUse::defer_all>;
+  kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
       tree, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count,
       static_cast<unsigned>(traverse_blocks), results);
   SNAG_CUDA_CHECK_LAUNCH();

@@ -99,11 +99,14 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 
 /// The candidate pairs of the traversal (one thread per leaf position, in leaf order) and those
 /// of the neighbour list (one thread per pair), each through detect::test_candidate_pair: one
-/// launch, the traversal's blocks first (they run longest).
+/// launch, the traversal's blocks first (they run longest). With FilterUse::defer_all every
+/// test goes to the uncertain buffer (`--exact all`); a kernel of its own, so that the usual
+/// one carries no branch for it.
 void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs,
                          const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, cudaStream_t stream);
+                         const ResultBuffers& results, detect::FilterUse use,
+                         cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with

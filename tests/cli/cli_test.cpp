@@ -77,7 +77,7 @@ TEST(CliCheck, HandBuiltSequenceReports) {
             "3,seq/f.0003.obj,3,0,0,0,0,0,0,0\n");
 
   const auto j = nlohmann::json::parse(read_text(tmp.path() / "out" / "report.json"));
-  EXPECT_EQ(j.at("schema"), "snag-report/1");
+  EXPECT_EQ(j.at("schema"), "snag-report/2");
   // The default backend, auto, is the GPU where snag has CUDA and a device is present.
   const std::string backend = j.at("settings").at("backend");
   EXPECT_TRUE(backend == "cpu" || backend == "cuda") << backend;

@@ -5,6 +5,7 @@
 // Without a GPU every test skips with a loud message (CI has nvcc but no GPU).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -40,7 +41,8 @@ struct Filtered {
   detect::FilteredFrame frame;
 };
 
-Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positions, bool build) {
+Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positions, bool build,
+                  detect::FilterUse use = detect::FilterUse::certify) {
   Filtered f;
   backend.set_positions(positions);
   f.scan = backend.scan_degenerate();
@@ -49,7 +51,7 @@ Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positio
   else
     backend.refit();
   f.quality = backend.tree_quality();
-  f.frame = backend.detect(f.scan.degenerate);
+  f.frame = backend.detect(f.scan.degenerate, use);
   return f;
 }
 
@@ -65,7 +67,8 @@ void expect_same(const Filtered& cpu, const Filtered& gpu, const std::string& wh
 }
 
 /// Both backends on one mesh, one frame, from a fresh build.
-void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_t capacity = 0) {
+void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_t capacity = 0,
+                          detect::FilterUse use = detect::FilterUse::certify) {
   const detect::Topology topology =
       detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   auto cpu = detect::make_cpu_backend(2);
@@ -73,7 +76,8 @@ void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_
   if (capacity > 0) gpu->set_result_capacity(capacity);
   cpu->set_topology(topology);
   gpu->set_topology(topology);
-  expect_same(filtered(*cpu, mesh.positions, true), filtered(*gpu, mesh.positions, true), what);
+  expect_same(filtered(*cpu, mesh.positions, true, use), filtered(*gpu, mesh.positions, true, use),
+              what);
 }
 
 detect::FrameResult check_on_gpu(const SmallMesh& mesh) {
@@ -305,6 +309,71 @@ TEST(CudaDetect, SharedDataFilesMatchTheCpu) {
     ++files;
   }
   EXPECT_GT(files, 10);
+}
+
+TEST(CudaDetect, EveryTestDeferredMatchesTheCpu) {
+  SNAG_REQUIRE_GPU();
+  const auto defer = detect::FilterUse::defer_all;
+  for (uint32_t seed = 1; seed <= 20; ++seed) {
+    const int32_t n = 20 + static_cast<int32_t>(seed * 7 % 90);
+    const SmallMesh mesh = lattice_soup(n, n, 3 + static_cast<int>(seed % 5), seed);
+    expect_same_filtered(mesh, "seed " + std::to_string(seed), 0, defer);
+  }
+  const SmallMesh grid = folded_grid(40, 30);
+  expect_same_filtered(grid, "folded grid", 0, defer);
+  // Far more tests than the buffers first hold: every one is deferred.
+  expect_same_filtered(random_soup(20000, 7, 0.3), "soup 20000", 64, defer);
+  // And nothing is decided on the way: no hit, no miss, only duplicates among the pairs.
+  auto gpu = gpu_backend();
+  const detect::Topology topology =
+      detect::make_topology(grid.triangles, static_cast<int32_t>(grid.positions.size()));
+  gpu->set_topology(topology);
+  const Filtered f = filtered(*gpu, grid.positions, true, defer);
+  EXPECT_TRUE(f.frame.pairs.empty());
+  EXPECT_EQ(f.frame.filtered_tests, 0);
+  EXPECT_GT(f.frame.uncertain.size(), static_cast<size_t>(f.frame.candidate_pairs));
+}
+
+TEST(CudaDetect, ExactModesMatchTheCpuAndBruteForce) {
+  SNAG_REQUIRE_GPU();
+  // Mode all needs a confirmer; brute force (exact integers, no tree) plays CGAL's part here.
+  struct BruteForceConfirmer final : detect::PairConfirmer {
+    std::vector<detect::FacePair> expected;
+    std::vector<detect::Disagreement> confirm(const detect::ExactContext&,
+                                              std::span<const detect::FacePair> pairs) override {
+      std::vector<detect::Disagreement> wrong;
+      for (const detect::FacePair& p : pairs)
+        if (std::find(expected.begin(), expected.end(), p) == expected.end())
+          wrong.push_back({p, "not a brute-force pair"});
+      return wrong;
+    }
+  };
+  for (uint32_t seed = 1; seed <= 12; ++seed) {
+    const SmallMesh mesh = lattice_soup(80, 60, 4, seed);
+    const std::vector<detect::FacePair> expected = brute_force(mesh);
+    for (detect::ExactMode mode : {detect::ExactMode::off, detect::ExactMode::all}) {
+      auto confirmer = std::make_shared<BruteForceConfirmer>();
+      confirmer->expected = expected;
+      detect::CheckSettings settings;
+      settings.exact = mode;
+      auto run = [&](std::unique_ptr<detect::Backend> backend) {
+        detect::Checker checker(std::move(backend), std::make_shared<IntegerResolver>(), settings,
+                                confirmer);
+        checker.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+        return checker.check(mesh.positions);
+      };
+      const detect::FrameResult gpu = run(gpu_backend()), cpu = run(detect::make_cpu_backend(2));
+      const std::string what = "seed " + std::to_string(seed) + " mode " +
+                               std::string(detect::to_string(mode));
+      EXPECT_EQ(gpu.pairs, cpu.pairs) << what;
+      EXPECT_EQ(gpu.degenerate, cpu.degenerate) << what;
+      EXPECT_EQ(gpu.uncertain_tests, cpu.uncertain_tests) << what;
+      if (mode == detect::ExactMode::all) {
+        EXPECT_EQ(gpu.pairs, expected) << what;
+        EXPECT_EQ(gpu.confirmed_pairs, static_cast<int64_t>(expected.size())) << what;
+      }
+    }
+  }
 }
 
 TEST(CudaBackend, EmptyAndSingleTriangleMeshes) {

@@ -215,7 +215,7 @@ TEST(ReportCsv, QuotesOnlyWhenNeeded) {
 
 TEST(ReportJson, ParsesBackWithTheFields) {
   const auto j = nlohmann::json::parse(report_json(hand_built_report()));
-  EXPECT_EQ(j.at("schema"), "snag-report/1");
+  EXPECT_EQ(j.at("schema"), "snag-report/2");
   EXPECT_EQ(j.at("snag").at("version"), "9.9.9");
 
   const auto& set = j.at("settings");
@@ -311,7 +311,7 @@ TEST(ReportWrite, WritesTheThreeFilesAndNothingElse) {
   std::ostringstream pairs;
   write_pairs_csv(pairs, r);
   EXPECT_EQ(read_all(out / "pairs.csv"), pairs.str());
-  EXPECT_EQ(nlohmann::json::parse(read_all(out / "report.json")).at("schema"), "snag-report/1");
+  EXPECT_EQ(nlohmann::json::parse(read_all(out / "report.json")).at("schema"), "snag-report/2");
 
   // A second run replaces the files in place.
   Report r2 = r;

@@ -3,8 +3,6 @@
 // crossing/touching kinds against CGAL's exact intersection construction.
 #include <gtest/gtest.h>
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
-#include <CGAL/intersections.h>
 
 #include <filesystem>
 #include <random>
@@ -37,36 +35,11 @@ Pairs ids_of(const std::vector<detect::FacePair>& pairs) {
   return ids;
 }
 
-/// The kind from CGAL's exact construction of the intersection: a crossing is a segment of
-/// positive length between non-coplanar triangles that each have corners strictly on both
-/// sides of the other's plane.
-detect::PairKind reference_kind(std::span<const geom::Vec3d> positions, const geom::Tri& f,
-                                const geom::Tri& g) {
-  using K = CGAL::Exact_predicates_exact_constructions_kernel;
-  auto P = [&](int32_t v) { return K::Point_3(positions[v].x, positions[v].y, positions[v].z); };
-  const K::Triangle_3 tf(P(f.v[0]), P(f.v[1]), P(f.v[2])), tg(P(g.v[0]), P(g.v[1]), P(g.v[2]));
-  auto straddles = [&](const K::Triangle_3& t, const geom::Tri& other) {
-    bool pos = false, neg = false;
-    for (int i = 0; i < 3; ++i) {
-      const auto o = CGAL::orientation(t[0], t[1], t[2], P(other.v[i]));
-      pos |= o == CGAL::POSITIVE;
-      neg |= o == CGAL::NEGATIVE;
-    }
-    return pos && neg;
-  };
-  if (!straddles(tf, g) || !straddles(tg, f)) return detect::PairKind::touching;
-  const auto result = CGAL::intersection(tf, tg);
-  if (!result) return detect::PairKind::touching;
-  if (const K::Segment_3* s = boost::get<K::Segment_3>(&*result); s && !s->is_degenerate())
-    return detect::PairKind::crossing;
-  return detect::PairKind::touching;
-}
-
 void expect_kinds_match(std::span<const geom::Vec3d> positions,
                         std::span<const geom::Tri> triangles,
                         const std::vector<detect::FacePair>& pairs, const std::string& what) {
   for (const auto& p : pairs)
-    ASSERT_EQ(p.kind, reference_kind(positions, triangles[p.a], triangles[p.b]))
+    ASSERT_EQ(p.kind, cgal_pair_kind(positions, triangles[p.a], triangles[p.b]))
         << what << ": pair " << p.a << "," << p.b;
 }
 

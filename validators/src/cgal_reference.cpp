@@ -1,6 +1,8 @@
 #include "snag/validators/cgal_reference.h"
 
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/box_intersection_d.h>
@@ -34,10 +36,10 @@ void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
 }
 
-/// CGAL's do_faces_intersect rules (Polygon_mesh_processing/self_intersections.h), with the
-/// shared vertices of two faces taken from their ids instead of halfedge adjacency.
-bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
-                     const geom::Tri& g) {
+}  // namespace
+
+bool cgal_faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                          const geom::Tri& g) {
   int shared = 0, fi = -1, gi = -1;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -67,7 +69,36 @@ bool faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
   return CGAL::do_intersect(tf, tg);
 }
 
-}  // namespace
+detect::PairKind cgal_pair_kind(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                                const geom::Tri& g) {
+  auto P = [&](int32_t v) { return point_of(positions[v]); };
+  // Each triangle has corners strictly on both sides of the other's plane (which also rules
+  // out coplanar pairs).
+  auto straddles = [&](const geom::Tri& t, const geom::Tri& plane) {
+    bool positive = false, negative = false;
+    for (int i = 0; i < 3; ++i) {
+      const CGAL::Orientation o =
+          CGAL::orientation(P(plane.v[0]), P(plane.v[1]), P(plane.v[2]), P(t.v[i]));
+      positive |= o == CGAL::POSITIVE;
+      negative |= o == CGAL::NEGATIVE;
+    }
+    return positive && negative;
+  };
+  if (!straddles(f, g) || !straddles(g, f)) return detect::PairKind::touching;
+  // Then each meets the other's plane in a segment on the planes' common line, and the pair
+  // crosses when the two segments overlap in more than a point: CGAL constructs the
+  // intersection exactly.
+  using Exact = CGAL::Exact_predicates_exact_constructions_kernel;
+  auto E = [&](int32_t v) {
+    return Exact::Point_3(positions[v].x, positions[v].y, positions[v].z);
+  };
+  const Exact::Triangle_3 tf(E(f.v[0]), E(f.v[1]), E(f.v[2])), tg(E(g.v[0]), E(g.v[1]), E(g.v[2]));
+  const auto meet = CGAL::intersection(tf, tg);
+  if (!meet) return detect::PairKind::touching;
+  const auto* segment = boost::get<Exact::Segment_3>(&*meet);
+  return segment && !segment->is_degenerate() ? detect::PairKind::crossing
+                                              : detect::PairKind::touching;
+}
 
 struct CgalSequence::State {
   Mesh mesh;
@@ -139,7 +170,7 @@ std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
   std::vector<std::pair<int32_t, int32_t>> pairs;
   CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
       pointers.begin(), pointers.end(), [&](const Box* a, const Box* b) {
-        if (faces_intersect(positions, triangles[a->info()], triangles[b->info()]))
+        if (cgal_faces_intersect(positions, triangles[a->info()], triangles[b->info()]))
           pairs.emplace_back(a->info(), b->info());
       });
   sort_pairs(pairs);

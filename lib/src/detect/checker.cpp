@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numeric>
 
 #include "snag/detect/pairs.h"
+#include "snag/detect/resolve.h"
 #include "snag/detect/topology.h"
 #include "snag/error.h"
 
@@ -19,9 +21,15 @@ double seconds_since(Clock::time_point start) {
 }  // namespace
 
 Checker::Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver,
-                 CheckSettings settings)
-    : backend_(std::move(backend)), resolver_(std::move(resolver)), settings_(settings) {
+                 CheckSettings settings, std::shared_ptr<PairConfirmer> confirmer)
+    : backend_(std::move(backend)),
+      resolver_(std::move(resolver)),
+      confirmer_(std::move(confirmer)),
+      settings_(settings) {
+  if (settings_.exact == ExactMode::off) resolver_ = make_rounded_resolver();
   if (!backend_ || !resolver_) throw InternalError("Checker needs a backend and an exact resolver");
+  if (settings_.exact == ExactMode::all && !confirmer_)
+    throw InternalError("--exact all needs a pair confirmer");
 }
 
 Checker::~Checker() = default;
@@ -50,8 +58,16 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   const ExactContext context{positions, topology_.get()};
   backend_->set_positions(positions);
 
-  // Zero-area triangles first: they are left out of the search and own no edges.
-  DegeneracyScan scan = backend_->scan_degenerate();
+  // Zero-area triangles first: they are left out of the search and own no edges. Mode `all`
+  // decides every triangle exactly.
+  const bool exact_all = settings_.exact == ExactMode::all;
+  DegeneracyScan scan;
+  if (exact_all) {
+    scan.uncertain.resize(static_cast<size_t>(topology_->triangle_count()));
+    std::iota(scan.uncertain.begin(), scan.uncertain.end(), 0);
+  } else {
+    scan = backend_->scan_degenerate();
+  }
   result.degenerate = std::move(scan.degenerate);
   if (!scan.uncertain.empty()) {
     const auto start = Clock::now();
@@ -89,11 +105,13 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   }
   result.tree_quality = backend_->tree_quality();
 
-  FilteredFrame frame = backend_->detect(result.degenerate);
+  FilteredFrame frame = backend_->detect(
+      result.degenerate, exact_all ? FilterUse::defer_all : FilterUse::certify);
   result.times.traverse = frame.traverse_seconds;
   result.times.classify = frame.classify_seconds;
   result.candidate_pairs = frame.candidate_pairs;
-  result.filtered_tests = frame.filtered_tests;
+  // With `all`, the kinds the backend classified (of duplicated faces) are decided again below.
+  result.filtered_tests = exact_all ? 0 : frame.filtered_tests;
 
   // What the filter could not certify: edge-triangle tests, then the kinds of pairs.
   const auto exact_start = Clock::now();
@@ -116,7 +134,7 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   std::vector<FacePair> unclassified;
   std::vector<size_t> where;
   for (size_t i = 0; i < frame.pairs.size(); ++i)
-    if (!frame.kind_certain[i]) {
+    if (!frame.kind_certain[i] || exact_all) {
       unclassified.push_back(frame.pairs[i]);
       where.push_back(i);
     }
@@ -128,6 +146,21 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   }
   result.times.exact += seconds_since(exact_start);
   result.pairs = std::move(frame.pairs);
+
+  if (exact_all) {
+    const auto confirm_start = Clock::now();
+    const std::vector<Disagreement> wrong = confirmer_->confirm(context, result.pairs);
+    if (!wrong.empty()) {
+      std::string message = "the independent check contradicts " + std::to_string(wrong.size()) +
+                            " reported pair(s):";
+      for (size_t i = 0; i < std::min<size_t>(wrong.size(), 10); ++i)
+        message += " (" + std::to_string(wrong[i].pair.a) + ", " + std::to_string(wrong[i].pair.b) +
+                   ", " + std::string(to_string(wrong[i].pair.kind)) + ": " + wrong[i].what + ")";
+      throw InternalError(message);
+    }
+    result.confirmed_pairs = static_cast<int64_t>(result.pairs.size());
+    result.times.confirm = seconds_since(confirm_start);
+  }
   return result;
 }
 

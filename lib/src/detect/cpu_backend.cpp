@@ -72,7 +72,14 @@ class CpuBackend final : public Backend {
     return tree_.quality();
   }
 
-  FilteredFrame detect(std::span<const int32_t> degenerate) override {
+  FilteredFrame detect(std::span<const int32_t> degenerate, FilterUse use) override {
+    return use == FilterUse::certify ? detect_with<FilterUse::certify>(degenerate)
+                                     : detect_with<FilterUse::defer_all>(degenerate);
+  }
+
+ private:
+  template <FilterUse use>
+  FilteredFrame detect_with(std::span<const int32_t> degenerate) {
     const Topology& topo = *topology_;
     const int32_t n = topo.triangle_count();
     FilteredFrame frame;
@@ -90,9 +97,11 @@ class CpuBackend final : public Backend {
                             n,
                             static_cast<int32_t>(topo.edges.size())};
     planes_.resize(static_cast<size_t>(n));
+    if constexpr (use == FilterUse::certify) {
 #pragma omp parallel for num_threads(threads_) schedule(static)
-    for (int32_t t = 0; t < n; ++t)
-      planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+      for (int32_t t = 0; t < n; ++t)
+        planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+    }
     const FrameView frame_view{positions_.data(), planes_.data()};
     const bvh::TreeView tree = tree_.view();
 
@@ -108,7 +117,7 @@ class CpuBackend final : public Backend {
         if (degenerate_flags[t] || degenerate_flags[x]) continue;
         ++sink.candidates;
         const uint32_t shared = topo.neighbor_shared[i];
-        test_pair_given_shared(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
+        test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
       }
       // The other candidates from the traversal: the leaves of each group of up to four
       // consecutive positions walk the tree together (for_each_later_overlap_grouped), groups
@@ -125,7 +134,7 @@ class CpuBackend final : public Backend {
                                  view.every_vertex_listed))
             return;
           ++sink.candidates;
-          test_candidate_pair(frame_view, view, t, x, sink);
+          test_candidate_pair<use>(frame_view, view, t, x, sink);
         });
       }
     }
@@ -161,7 +170,6 @@ class CpuBackend final : public Backend {
     return frame;
   }
 
- private:
   mesh::MeshView mesh_view() const {
     return {positions_.data(), topology_->triangles.data(), static_cast<int32_t>(positions_.size()),
             topology_->triangle_count()};

@@ -11,7 +11,7 @@ using nlohmann::ordered_json;
 ordered_json seconds_json(const FrameRecord& f) {
   return {{"read", f.read_seconds},       {"build", f.times.build}, {"refit", f.times.refit},
           {"traverse", f.times.traverse}, {"exact", f.times.exact}, {"classify", f.times.classify},
-          {"total", f.times.total()}};
+          {"confirm", f.times.confirm},   {"total", f.times.total()}};
 }
 
 ordered_json frame_json(const FrameRecord& f) {
@@ -40,7 +40,8 @@ ordered_json frame_json(const FrameRecord& f) {
                  {"degenerate", f.degenerate.size()},
                  {"candidate_pairs", f.candidate_pairs},
                  {"filtered_tests", f.filtered_tests},
-                 {"uncertain_tests", f.uncertain_tests}};
+                 {"uncertain_tests", f.uncertain_tests},
+                 {"confirmed_pairs", f.confirmed_pairs}};
   j["seconds"] = seconds_json(f);
   j["pairs"] = std::move(pairs);
   j["degenerate"] = std::move(degenerate);
@@ -60,6 +61,7 @@ std::string report_json(const Report& report) {
                    {"backend_requested", set.backend_requested},
                    {"threads", set.threads},
                    {"exact", set.exact},
+                   {"exact_predicates", set.exact_predicates},
                    {"weld", set.weld ? ordered_json(*set.weld) : ordered_json(nullptr)},
                    {"rebuild", set.rebuild},
                    {"rebuild_threshold", set.rebuild_threshold},
@@ -96,6 +98,7 @@ std::string report_json(const Report& report) {
       {"touching", s.touching},
       {"degenerate", s.degenerate},
       {"uncertain_tests", s.uncertain_tests},
+      {"confirmed_pairs", s.confirmed_pairs},
       {"topology_changes", s.topology_changes},
       {"builds", report.builds},
       {"rebuilds", report.rebuilds},

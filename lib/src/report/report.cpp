@@ -63,6 +63,7 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
   record.candidate_pairs = result.candidate_pairs;
   record.filtered_tests = result.filtered_tests;
   record.uncertain_tests = result.uncertain_tests;
+  record.confirmed_pairs = result.confirmed_pairs;
   record.rebuilt = result.rebuilt;
   record.tree_quality = result.tree_quality;
   record.times = result.times;
@@ -85,6 +86,7 @@ Summary summarize(const Report& report) {
     s.touching += pairs - crossing;
     s.degenerate += static_cast<int64_t>(f.degenerate.size());
     s.uncertain_tests += f.uncertain_tests;
+    s.confirmed_pairs += f.confirmed_pairs;
     s.topology_changes += f.topology_changed;
     s.check_seconds += f.times.total();
     s.read_seconds += f.read_seconds;

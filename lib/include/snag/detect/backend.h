@@ -49,8 +49,11 @@ class Backend {
   virtual void refit() = 0;
   /// Sum of internal-node half areas over the root's half area (1 for a single triangle).
   virtual double tree_quality() = 0;
-  /// Traversal and the filtered narrow phase; `degenerate` (sorted) are left out.
-  virtual FilteredFrame detect(std::span<const int32_t> degenerate) = 0;
+  /// Traversal and the narrow phase; `degenerate` (sorted) are left out. With
+  /// FilterUse::defer_all every edge-triangle test of every candidate pair is returned in
+  /// `uncertain`, and `pairs` holds only duplicated faces (found by their ids).
+  virtual FilteredFrame detect(std::span<const int32_t> degenerate,
+                               FilterUse use = FilterUse::certify) = 0;
 };
 
 }  // namespace snag::detect

@@ -1,6 +1,7 @@
 // Checking a sequence of frames that share one topology: the tree is built once per topology,
 // refit every frame (rebuilt when its quality degrades, per RebuildPolicy), traversed, and what
-// the double-precision filter cannot certify is decided by an ExactResolver.
+// the double-precision filter cannot certify is decided by an ExactResolver, as the ExactMode
+// says (see exact.h).
 #pragma once
 
 #include <memory>
@@ -22,13 +23,16 @@ struct CheckSettings {
   /// With `automatic`, rebuild when the refit tree's quality (sum of internal-node half areas
   /// over the root's half area) exceeds this factor times its value right after the last build.
   double rebuild_threshold = 1.5;
+  ExactMode exact = ExactMode::uncertain;
 };
 
 class Checker {
  public:
-  /// `resolver` decides what the filter cannot; it must not be null.
+  /// `resolver` decides what the filter cannot (modes `uncertain`, `all`; `off` decides with
+  /// rounded doubles and ignores it); `confirmer` checks every reported pair (mode `all`,
+  /// where it is required).
   Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver> resolver,
-          CheckSettings settings = {});
+          CheckSettings settings = {}, std::shared_ptr<PairConfirmer> confirmer = nullptr);
   ~Checker();
 
   /// Sets the triangles (indices into each frame's positions). Returns true when they differ
@@ -46,6 +50,7 @@ class Checker {
  private:
   std::unique_ptr<Backend> backend_;
   std::shared_ptr<ExactResolver> resolver_;
+  std::shared_ptr<PairConfirmer> confirmer_;
   CheckSettings settings_;
   std::unique_ptr<struct Topology> topology_;
   bool needs_build_ = true;

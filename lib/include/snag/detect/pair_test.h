@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "snag/detect/exact.h"
 #include "snag/detect/topology.h"
 #include "snag/geom/hd.h"
 #include "snag/geom/narrow_phase.h"
@@ -60,18 +61,28 @@ SNAG_HD_INLINE bool separated(const geom::Sign side[3], uint32_t shared) {
   return common != geom::Sign::zero;
 }
 
+/// Calls f(k, edge) for each edge k (corners k, k + 1) of `t` that t represents (`owned`) and
+/// that is not an edge of `x` too (`shared`: t's corners that are x's vertices): the
+/// edge-triangle tests of t's side of the pair (t, x).
+template <class F>
+SNAG_HD_INLINE void for_each_tested_edge(const TopologyView& topo, int32_t t, uint8_t owned,
+                                         uint32_t shared, F&& f) {
+  for (int k = 0; k < 3; ++k) {
+    if (!(owned & (1u << k))) continue;
+    const uint32_t edge_corners = (1u << k) | (1u << ((k + 1) % 3));
+    if ((shared & edge_corners) == edge_corners) continue;  // an edge of x itself
+    f(k, topo.triangle_edges[t][k]);
+  }
+}
+
 /// Tests the edges triangle `t` represents against triangle `x`; `side` holds t's corners'
 /// sides w.r.t. x's plane.
 template <class P, class Sink>
 SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, int32_t t,
                                      const geom::Tri& tt, uint8_t owned, uint32_t shared, int32_t x,
                                      const geom::Tri& xt, const geom::Sign side[3], Sink& sink) {
-  for (int k = 0; k < 3; ++k) {
-    if (!(owned & (1u << k))) continue;
+  for_each_tested_edge(topo, t, owned, shared, [&](int k, int32_t edge) {
     const int32_t p = tt.v[k], q = tt.v[(k + 1) % 3];
-    const uint32_t edge_corners = (1u << k) | (1u << ((k + 1) % 3));
-    if ((shared & edge_corners) == edge_corners) continue;  // an edge of x itself
-    const int32_t edge = topo.triangle_edges[t][k];
     switch (geom::edge_hits_triangle(pred, p, q, xt, side[k], side[(k + 1) % 3])) {
       case geom::Answer::yes:
         sink.hit(edge, x);
@@ -83,7 +94,7 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
         sink.miss();
         break;
     }
-  }
+  });
 }
 
 /// What the pair tests read of one frame: the positions and every triangle's plane
@@ -146,13 +157,39 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
   if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, x_shared, t, tt, side_x, sink);
 }
 
-/// The narrow phase of a candidate pair from the traversal (shared corners computed here).
+/// The narrow phase of (t, x) with the filter left out (`--exact all`): every edge-triangle
+/// test the pair needs is reported uncertain, for exact predicates to decide; no sign is
+/// computed. Duplicated faces are found by their ids, as in test_pair_given_shared.
 template <class Sink>
+SNAG_HD void defer_pair_given_shared(const TopologyView& topo, int32_t t, int32_t x,
+                                     uint32_t t_shared, uint32_t x_shared, Sink& sink) {
+  if (t_shared == 7u) {
+    sink.duplicate(t, x);
+    return;
+  }
+  for_each_tested_edge(topo, t, topo.owned_edges[t], t_shared,
+                       [&](int, int32_t edge) { sink.uncertain(edge, x); });
+  for_each_tested_edge(topo, x, topo.owned_edges[x], x_shared,
+                       [&](int, int32_t edge) { sink.uncertain(edge, t); });
+}
+
+/// The narrow phase of a pair whose shared corners are known, as `use` says.
+template <FilterUse use, class Sink>
+SNAG_HD_INLINE void test_pair(const FrameView& frame, const TopologyView& topo, int32_t t,
+                              int32_t x, uint32_t t_shared, uint32_t x_shared, Sink& sink) {
+  if constexpr (use == FilterUse::certify)
+    test_pair_given_shared(frame, topo, t, x, t_shared, x_shared, sink);
+  else
+    defer_pair_given_shared(topo, t, x, t_shared, x_shared, sink);
+}
+
+/// The narrow phase of a candidate pair from the traversal (shared corners computed here).
+template <FilterUse use = FilterUse::certify, class Sink>
 SNAG_HD void test_candidate_pair(const FrameView& frame, const TopologyView& topo, int32_t t,
                                  int32_t x, Sink& sink) {
   uint32_t t_shared, x_shared;
   shared_corners(topo.triangles[t], topo.triangles[x], t_shared, x_shared);
-  test_pair_given_shared(frame, topo, t, x, t_shared, x_shared, sink);
+  test_pair<use>(frame, topo, t, x, t_shared, x_shared, sink);
 }
 
 }  // namespace snag::detect

@@ -31,7 +31,8 @@ struct StageTimes {
   double traverse = 0;  ///< traversal with the filtered narrow phase
   double exact = 0;     ///< uncertain tests decided with exact predicates
   double classify = 0;  ///< sorting, deduplication and crossing/touching
-  double total() const { return build + refit + traverse + exact + classify; }
+  double confirm = 0;   ///< independent confirmation of the reported pairs (`--exact all`)
+  double total() const { return build + refit + traverse + exact + classify + confirm; }
 };
 
 struct FrameResult {
@@ -39,7 +40,10 @@ struct FrameResult {
   std::vector<int32_t> degenerate;  ///< zero-area triangles, sorted; left out of the search
   int64_t candidate_pairs = 0;      ///< pairs whose boxes overlap
   int64_t filtered_tests = 0;       ///< orientation-based tests decided by the double filter
-  int64_t uncertain_tests = 0;      ///< tests the filter could not certify, decided exactly
+  /// Tests the filter did not certify, decided by the exact stage (with `--exact off`, by the
+  /// rounded doubles: decisions outside the filter's error bound; with `all`, every test).
+  int64_t uncertain_tests = 0;
+  int64_t confirmed_pairs = 0;      ///< pairs confirmed independently (`--exact all`)
   bool rebuilt = false;             ///< the tree was (re)built for this frame
   double tree_quality = 0;          ///< sum of internal-node half areas over the root's
   StageTimes times;

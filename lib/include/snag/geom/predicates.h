@@ -196,4 +196,40 @@ struct FilteredPredicates {
   }
 };
 
+
+/// The signs of the plain double evaluation with no error bound, zero only when the rounded
+/// determinant is zero: what `--exact off` decides the filter's uncertain tests with. The same
+/// expressions as the filter (plane_side, orient2d), so where the filter is certain both agree;
+/// where it is not, the sign may be wrong (a near-degenerate configuration, or an exact zero
+/// that rounds to a tiny nonzero value). Never answers `uncertain`.
+struct RoundedPredicates {
+  const Vec3d* positions;
+
+  SNAG_HD_INLINE static Sign sign_of(double det) {
+    return det > 0 ? Sign::positive : (det < 0 ? Sign::negative : Sign::zero);
+  }
+  SNAG_HD_INLINE Sign orient3d(int32_t a, int32_t b, int32_t c, int32_t d) const {
+    const Vec3d pa = positions[a], pd = positions[d];
+    const PlaneCoefficients k = PlaneCoefficients::of(pa, positions[b], positions[c]);
+    return sign_of((pd.x - pa.x) * k.minor[0] + (pd.y - pa.y) * k.minor[1] +
+                   (pd.z - pa.z) * k.minor[2]);
+  }
+  SNAG_HD_INLINE Sign orient2d(int32_t a, int32_t b, int32_t c, int axis) const {
+    double au, av, bu, bv, cu, cv;
+    project(positions[a], axis, au, av);
+    project(positions[b], axis, bu, bv);
+    project(positions[c], axis, cu, cv);
+    return sign_of((au - cu) * (bv - cv) - (av - cv) * (bu - cu));
+  }
+  SNAG_HD_INLINE int dominant_axis(int32_t a, int32_t b, int32_t c) const {
+    return geom::dominant_axis(positions[a], positions[b], positions[c]);
+  }
+  struct Plane {
+    const RoundedPredicates* pred;
+    int32_t a, b, c;
+    SNAG_HD_INLINE Sign side(int32_t d) const { return pred->orient3d(a, b, c, d); }
+  };
+  SNAG_HD_INLINE Plane plane(int32_t a, int32_t b, int32_t c) const { return {this, a, b, c}; }
+};
+
 }  // namespace snag::geom

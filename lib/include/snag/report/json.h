@@ -1,6 +1,6 @@
-// report.json, schema "snag-report/1" (documented field by field in man/snag.1, REPORT.JSON):
+// report.json, schema "snag-report/2" (documented field by field in man/snag.1, REPORT.JSON):
 //
-//   { "schema": "snag-report/1", "snag": {"version"},
+//   { "schema": "snag-report/2", "snag": {"version"},
 //     "settings": {backend, backend_requested, threads, exact, weld, rebuild, rebuild_threshold,
 //                  fail_on, frames},
 //     "inputs":   {sequence, ids, files: [...], coincident_vertices, welded_vertices},
@@ -24,7 +24,7 @@
 
 namespace snag::report {
 
-inline constexpr std::string_view json_schema = "snag-report/1";
+inline constexpr std::string_view json_schema = "snag-report/2";
 
 /// The report as JSON text (two-space indentation, a trailing newline).
 std::string report_json(const Report& report);

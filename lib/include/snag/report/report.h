@@ -49,7 +49,10 @@ struct FrameRecord {
   std::vector<Face> degenerate;  ///< sorted by face
   int64_t candidate_pairs = 0;
   int64_t filtered_tests = 0;
-  int64_t uncertain_tests = 0;    ///< tests the double filter left to exact arithmetic
+  /// Tests the double filter did not certify, decided by settings.exact_predicates (with
+  /// --exact off: decisions outside the filter's error bound; with all: every test).
+  int64_t uncertain_tests = 0;
+  int64_t confirmed_pairs = 0;    ///< pairs confirmed independently by CGAL (--exact all)
   bool topology_changed = false;  ///< the face list differs from the previous checked frame's
   bool rebuilt = false;           ///< the tree was built for this frame (always true for the first)
   double tree_quality = 0;
@@ -70,7 +73,10 @@ struct Settings {
   std::string backend;            ///< backend that ran ("cpu")
   std::string backend_requested;  ///< as asked on the command line ("auto", "cpu")
   int threads = 0;                ///< worker threads used
-  std::string exact;              ///< who decides uncertain tests ("cgal")
+  std::string exact;              ///< the --exact mode: "off", "uncertain" or "all"
+  /// Who decides the tests the filter leaves: "cgal" (exact predicates) or "rounded" (the
+  /// signs of the rounded doubles, mode off).
+  std::string exact_predicates;
   std::optional<double> weld;     ///< --weld tolerance, if given
   std::string rebuild;            ///< "never", "auto" or "always"
   double rebuild_threshold = 0;   ///< quality factor that triggers a rebuild under "auto"
@@ -108,6 +114,7 @@ struct Summary {
   int64_t touching = 0;
   int64_t degenerate = 0;
   int64_t uncertain_tests = 0;
+  int64_t confirmed_pairs = 0;
   int64_t topology_changes = 0;
   double check_seconds = 0;  ///< sum of the frames' checking times
   double read_seconds = 0;

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "snag/detect/result.h"
 #include "snag/geom/vec3.h"
 
 namespace snag::validators {
@@ -48,5 +49,17 @@ class CgalSequence {
 /// on any triangle soup, including non-manifold ones.
 std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
     std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
+
+/// One pair under those rules: do non-degenerate triangles f and g (shared vertices by id)
+/// intersect beyond what their shared vertices explain?
+bool cgal_faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                          const geom::Tri& g);
+
+/// The kind of an intersecting pair, from CGAL alone: `crossing` when each triangle has
+/// corners strictly on both sides of the other's plane (CGAL::orientation) and CGAL's exact
+/// construction of their intersection (Epeck) is a segment of positive length; else
+/// `touching`. Independent of snag's four-sign derivation (geom::is_crossing).
+detect::PairKind cgal_pair_kind(std::span<const geom::Vec3d> positions, const geom::Tri& f,
+                                const geom::Tri& g);
 
 }  // namespace snag::validators
