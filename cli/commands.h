@@ -63,4 +63,22 @@ struct BenchGpuOptions {
 CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& options);
 int run_bench_gpu(const BenchGpuOptions& options);
 
+/// Options of `snag bench accuracy`, filled by CLI11.
+struct BenchAccuracyOptions {
+  std::vector<int> sizes = {2244, 27030, 35992};
+  int frames = 2;
+  int warmup = 1;
+  std::string hard_dir;
+  std::string data_dir;
+  std::vector<std::string> inputs;
+  std::string generator;
+  int threads = 0;
+  int device = 0;
+  std::string out_dir;
+};
+
+/// Adds the `accuracy` subcommand to `bench`; returns it.
+CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& options);
+int run_bench_accuracy(const BenchAccuracyOptions& options);
+
 }  // namespace snag::cli

@@ -29,6 +29,9 @@ int main(int argc, char** argv) {
     snag::cli::BenchGpuOptions bench_gpu;
     CLI::App* bench_gpu_command =
         snag::cli::add_bench_gpu_command(*app.get_subcommand("bench"), bench_gpu);
+    snag::cli::BenchAccuracyOptions bench_accuracy;
+    CLI::App* bench_accuracy_command =
+        snag::cli::add_bench_accuracy_command(*app.get_subcommand("bench"), bench_accuracy);
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
@@ -38,6 +41,7 @@ int main(int argc, char** argv) {
     if (check_command->parsed()) return snag::cli::run_check(check);
     if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);
     if (bench_gpu_command->parsed()) return snag::cli::run_bench_gpu(bench_gpu);
+    if (bench_accuracy_command->parsed()) return snag::cli::run_bench_accuracy(bench_accuracy);
     throw snag::InternalError("no subcommand ran");
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.

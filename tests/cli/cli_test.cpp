@@ -294,6 +294,7 @@ TEST(CliHelp, AgreesWithTheManPage) {
       {"snag check", {"check", "--help"}},
       {"snag bench cpu", {"bench", "cpu", "--help"}},
       {"snag bench gpu", {"bench", "gpu", "--help"}},
+      {"snag bench accuracy", {"bench", "accuracy", "--help"}},
   };
   for (const auto& [heading, args] : commands) {
     const std::string section = man_section(man, heading);
