@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One round on a GPU machine, from the repository root, with the build staged by
 # ../shared/gpu/stage into .gpu (see tests/cuda/README in the final report):
-#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick]
+#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [accuracy]
 # Logs go to $OUT (or ./out); a short table is printed last.
 set -uo pipefail
 out=${OUT:-out}; mkdir -p "$out"
@@ -71,6 +71,10 @@ PY
     bench)
       snag bench gpu --data "$SNAG_DATA_DIR" >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
       summary+=("bench gpu         rc=$rc")
+      ;;
+    accuracy)
+      snag bench accuracy --data "$SNAG_DATA_DIR" --out "$out/accuracy" >"$out/bench_accuracy.txt" 2>"$out/bench_accuracy.err"; rc=$?
+      summary+=("bench accuracy    rc=$rc")
       ;;
     bench-quick)
       snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
