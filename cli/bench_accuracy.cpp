@@ -205,7 +205,7 @@ Input hard_corpus(const fs::path& dir) {
     input.frames.push_back(std::move(m));
   }
   input.cases = static_cast<int>(input.frames.size());
-  input.name += " (" + std::to_string(input.cases) + " files)";
+  input.name += " (" + std::to_string(input.cases) + " cases)";
   return input;
 }
 
