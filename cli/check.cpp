@@ -2,10 +2,12 @@
 // standard output and, with --out, the reports.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -19,6 +21,7 @@
 #include "snag/mesh/weld.h"
 #include "snag/report/report.h"
 #include "snag/report/write.h"
+#include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
 #include "snag/validators/exact_modes.h"
 
@@ -223,11 +226,18 @@ int run_check(const CheckOptions& o) {
   std::string first_file;
   bool any_assimp = false;
 
-  for (size_t i = 0; i < frames.size(); ++i) {
+  // Frames are read ahead on their own threads while the current one is checked; at most
+  // `depth` frames are held at once whatever the sequence length.
+  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const int readers = std::clamp(threads / 4, 1, 4);
+  seq::FramePrefetcher prefetcher(frames, readers, readers + 2,
+                                  [](const seq::Frame& f) { return io::read_mesh(f.path); });
+  while (std::optional<seq::PrefetchedFrame> next = prefetcher.next()) {
+    const size_t i = next->index;
     const seq::Frame& frame = frames[i];
     const std::string file = frame.path.string();
-    const auto read_started = Clock::now();
-    mesh::Mesh mesh = io::read_mesh(frame.path);
+    const auto read_started = Clock::now();  // welding counts as reading
+    mesh::Mesh mesh = std::move(next->mesh);
     any_assimp = any_assimp || mesh.ids_from_assimp;
     const int32_t vertices = static_cast<int32_t>(mesh.positions.size());
 
@@ -265,7 +275,7 @@ int run_check(const CheckOptions& o) {
       file_triangles = mesh.triangles;
       checker->set_triangles(welded_triangles(mesh, representative), vertex_count);
     }
-    const double read_seconds = seconds_since(read_started);
+    const double read_seconds = next->read_seconds + seconds_since(read_started);
 
     const detect::FrameResult result = checker->check(mesh.positions);
     report::FrameRecord record = report::make_frame_record(
