@@ -519,6 +519,13 @@ struct NearDegenerateSettings {
   int32_t triangles = 120;
 };
 
+/// "seed 7 (bits 48, shifts 0 3 -2)": what a failure message names.
+inline std::string describe(uint32_t seed, const NearDegenerateSettings& s) {
+  return "seed " + std::to_string(seed) + " (bits " + std::to_string(s.bits) + ", shifts " +
+         std::to_string(s.shift[0]) + " " + std::to_string(s.shift[1]) + " " +
+         std::to_string(s.shift[2]) + ")";
+}
+
 inline SmallMesh near_degenerate_soup(uint32_t seed, const NearDegenerateSettings& s) {
   struct P {
     int64_t x, y, z;

@@ -12,6 +12,7 @@
 
 #include "detect_cases.h"
 #include "snag/bvh/tree.h"
+#include "require_gpu.h"
 #include "snag/cuda/cuda_backend.h"
 #include "snag/detect/cpu_backend.h"
 #include "snag/error.h"
@@ -20,11 +21,6 @@
 
 namespace snag::test {
 namespace {
-
-#define SNAG_REQUIRE_GPU()                                                                  \
-  do {                                                                                      \
-    if (cuda::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device: GPU test skipped"; \
-  } while (0)
 
 std::unique_ptr<cuda::CudaBackend> gpu_backend() {
   std::unique_ptr<detect::Backend> backend = cuda::make_cuda_backend(0);

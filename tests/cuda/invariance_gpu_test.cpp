@@ -11,16 +11,12 @@
 
 #include "detect_cases.h"
 #include "invariance.h"
+#include "require_gpu.h"
 #include "snag/cuda/cuda_backend.h"
 #include "snag/validators/exact_modes.h"
 
 namespace snag::test {
 namespace {
-
-#define SNAG_REQUIRE_GPU()                                                                  \
-  do {                                                                                      \
-    if (cuda::cuda_device_count() == 0) GTEST_SKIP() << "no CUDA device: GPU test skipped"; \
-  } while (0)
 
 /// The CUDA backend on device 0 with --exact uncertain and all, a fresh checker per mesh.
 std::vector<Method> gpu_methods() {
@@ -44,10 +40,7 @@ TEST(InvarianceGpu, RandomNearDegenerateSoupsAreCgalsAnswerUnderEveryTransform) 
   for (uint32_t seed = 0; seed < 24; ++seed) {
     const NearDegenerateSettings settings = near_degenerate_settings(seed);
     const SmallMesh mesh = near_degenerate_soup(seed, settings);
-    const std::string what =
-        "seed " + std::to_string(seed) + " (bits " + std::to_string(settings.bits) + ", shifts " +
-        std::to_string(settings.shift[0]) + " " + std::to_string(settings.shift[1]) + " " +
-        std::to_string(settings.shift[2]) + ")";
+    const std::string what = describe(seed, settings);
     std::vector<Transformed> transforms = standard_transforms(mesh, seed);
     ASSERT_GE(translation_count(transforms), 3) << what;
     transforms.insert(transforms.begin(), identity(mesh));

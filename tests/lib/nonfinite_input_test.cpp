@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 #include <limits>
 #include <string>
 #include <vector>
@@ -268,6 +269,27 @@ TEST(NonfinitePly, AsciiTokensForFloatAndDoubleWithTheirLine) {
           EXPECT_TRUE(contains(e.what(), std::string("'") + token + "'")) << e.what();
           EXPECT_TRUE(contains(e.what(), "vertex 2 (of 3)")) << e.what();
         }
+}
+
+TEST(NonfinitePly, AsciiFloatPropertyBeyondFloatRangeIsRejectedAndItsLargestValuesKept) {
+  // As a float, 1e39 and FLT_MAX + 2^103 (half an ulp above FLT_MAX, rounding to even) are
+  // infinite: a binary file could not hold them, so neither may a text one.
+  for (const char* token : {"1e39", "-1e39", "340282356779733661637539395458142568448"}) {
+    const PlyFile file = ply_with(Enc::ascii, "float", false, 0, 0, token);
+    const InputError e =
+        rejection([&] { return read_ply(file.bytes, "frame.0001.ply"); }, file.bytes);
+    EXPECT_EQ(e.line(), file.bad_at) << e.what();
+    EXPECT_TRUE(contains(e.what(), "does not fit its float property")) << e.what();
+  }
+  // FLT_MAX + 2^102 rounds to FLT_MAX as a float and is kept as written; a double property
+  // takes 1e39.
+  for (const auto& [type, token, value] :
+       {std::tuple{"float", "340282351709131260724621789471329746944", 0x1.fffffe8p127},
+        std::tuple{"double", "1e39", 1e39}}) {
+    const PlyFile file = ply_with(Enc::ascii, type, false, 0, 0, token);
+    const mesh::Mesh m = read_ply(file.bytes, "frame.0001.ply");
+    EXPECT_EQ(m.positions.at(2).x, value) << type << " " << token;
+  }
 }
 
 TEST(NonfinitePly, ReadMeshNamesTheFile) {

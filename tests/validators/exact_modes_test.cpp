@@ -3,6 +3,7 @@
 // internal error; `off` counts its unproven decisions and can be wrong where it says so.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "snag/detect/checker.h"
@@ -175,6 +176,24 @@ TEST(CgalConfirmer, ADisagreementIsAnInternalErrorNamingThePair) {
   // Mode all without a confirmer is refused outright.
   EXPECT_THROW(detect::Checker(detect::make_cpu_backend(1), make_cgal_resolver(), settings),
                InternalError);
+}
+
+TEST(ExactModes, NanAndInfinityAreInputErrorsInEveryMode) {
+  // Readers reject such files; the checker itself must not answer (NaN compares false, so
+  // pairs vanish) nor crash (CGAL traps converting infinity to an exact number).
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity()})
+    for (ExactMode mode : {ExactMode::off, ExactMode::uncertain, ExactMode::all}) {
+      Three m;
+      m.positions[5].x = bad;
+      try {
+        check(m.positions, m.triangles, mode);
+        FAIL() << "accepted " << bad << " with --exact " << detect::to_string(mode);
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("vertex 5"), std::string::npos) << e.what();
+      }
+    }
 }
 
 }  // namespace

@@ -75,10 +75,7 @@ TEST(Invariance, RandomNearDegenerateSoupsAreCgalsAnswerUnderEveryTransform) {
   for (uint32_t seed = 0; seed < 24; ++seed) {
     const NearDegenerateSettings settings = near_degenerate_settings(seed);
     const SmallMesh mesh = near_degenerate_soup(seed, settings);
-    const std::string what =
-        "seed " + std::to_string(seed) + " (bits " + std::to_string(settings.bits) + ", shifts " +
-        std::to_string(settings.shift[0]) + " " + std::to_string(settings.shift[1]) + " " +
-        std::to_string(settings.shift[2]) + ")";
+    const std::string what = describe(seed, settings);
     const test::Answer expected = cgal_answer(mesh);
     std::vector<Transformed> transforms = standard_transforms(mesh, seed);
     // Translation is never silently left out: the lattice leaves room for several.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 
 #include "snag/detect/pairs.h"
@@ -53,6 +54,19 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   if (static_cast<int64_t>(positions.size()) != topology_->vertex_count)
     throw InternalError("frame has " + std::to_string(positions.size()) +
                         " vertices, topology has " + std::to_string(topology_->vertex_count));
+  // Every decision assumes finite coordinates (NaN compares false everywhere, and CGAL cannot
+  // convert infinity to an exact number). Readers reject such files; this guards the API. A
+  // coordinate minus itself is 0 unless it is NaN or infinite, so one sum tells.
+  double poison = 0;
+  for (const geom::Vec3d& p : positions) poison += (p.x - p.x) + (p.y - p.y) + (p.z - p.z);
+  if (poison != 0) {  // NaN != 0 too
+    for (size_t v = 0; v < positions.size(); ++v)
+      if (!std::isfinite(positions[v].x) || !std::isfinite(positions[v].y) ||
+          !std::isfinite(positions[v].z))
+        throw InputError("frame", 0,
+                         "vertex " + std::to_string(v) +
+                             " has a NaN or infinite coordinate; expected finite numbers");
+  }
   FrameResult result;
   if (topology_->triangle_count() == 0) return result;
   const ExactContext context{positions, topology_.get()};

@@ -664,6 +664,13 @@ class AsciiBody {
           fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
                record_name(el, i) + " is not finite; expected a finite number");
         }
+        // A `float` property holds what a float can: a value that rounds to infinity as a float
+        // (FLT_MAX plus half its ulp, 2^103, or more) is one a binary file could not hold. In
+        // range, the text's value is kept as written, in double precision.
+        if (prop.type == Scalar::f32 && std::fabs(xyz[axis]) >= 0x1.ffffffp+127) {
+          fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+               record_name(el, i) + " does not fit its float property; expected a finite float");
+        }
       }
     }
     mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});

@@ -40,6 +40,7 @@ class Checker {
   bool set_triangles(std::span<const geom::Tri> triangles, int32_t vertex_count);
 
   /// Checks one frame. `positions` has vertex_count entries and must stay valid during the call.
+  /// Throws snag::InputError when a coordinate is NaN or infinite.
   FrameResult check(std::span<const geom::Vec3d> positions);
 
   int rebuild_count() const { return rebuilds_; }  ///< builds other than the first of each topology
