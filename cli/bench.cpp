@@ -46,13 +46,6 @@ struct Row {
   std::string note;
 };
 
-std::vector<std::pair<int32_t, int32_t>> pair_ids(const detect::FrameResult& r) {
-  std::vector<std::pair<int32_t, int32_t>> ids;
-  ids.reserve(r.pairs.size());
-  for (const auto& p : r.pairs) ids.emplace_back(p.a, p.b);
-  return ids;
-}
-
 Row run_case(const BenchCase& c, const BenchOptions& o) {
   const CaseFrames read = read_case(c, "snag bench");
   const std::vector<mesh::Mesh>& meshes = read.meshes;
@@ -87,7 +80,7 @@ Row run_case(const BenchCase& c, const BenchOptions& o) {
     cgal_sequence.set_positions(m.positions);
     const auto reference = cgal_sequence.self_intersections();
     const double cgal_seconds = std::chrono::duration<double>(Clock::now() - cgal_started).count();
-    if (pair_ids(r) != reference || pair_ids(built) != reference) {
+    if (validators::pair_ids(r.pairs) != reference || validators::pair_ids(built.pairs) != reference) {
       row.same = false;
       row.note = "frame " + std::to_string(it % meshes.size()) + ": snag " +
                  std::to_string(r.pairs.size()) + " pairs, CGAL " +
@@ -145,31 +138,13 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
   bench->require_subcommand(1, 1);
   CLI::App* cpu = bench->add_subcommand(
       "cpu", "Time snag's CPU path and CGAL's self_intersections side by side on the same frames");
-  cpu->add_option("--sizes", o.sizes,
-                  "Generated cloth sizes in triangles (0 or an empty list: none)")
-      ->type_name("T,...")
-      ->delimiter(',')
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_case_options(cpu, {&o.sizes, &o.data_dir, &o.inputs, &o.generator, &o.threads},
+                   "its scalable-ccd/cloth-ball frames are a case", "time");
   cpu->add_option("--frames", o.frames, "Timed frames per case, after the warm-up")
       ->type_name("N")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cpu->add_option("--warmup", o.warmup, "Untimed frames per case before the timed ones")
-      ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cpu->add_option("--data", o.data_dir,
-                  "The shared data folder; its scalable-ccd/cloth-ball frames are a case when "
-                  "present (default: $SNAG_DATA_DIR, else the one known at build time)")
-      ->type_name("DIR");
-  cpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")
-      ->type_name("SEQUENCE");
-  cpu->add_option("--generator", o.generator,
-                  "The snag-cloth sample generator (default: beside snag, in the build tree, "
-                  "or on PATH)")
-      ->type_name("PATH");
-  cpu->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

@@ -82,11 +82,10 @@ Method snag_method(const std::string& backend, detect::ExactMode mode, int threa
             std::shared_ptr<detect::Checker> checker =
                 validators::make_checker(make_backend(backend, threads, device), settings);
             checker->set_triangles(first.triangles, static_cast<int32_t>(first.positions.size()));
-            return [checker](const mesh::Mesh& m) {
+            return [checker, mode](const mesh::Mesh& m) {
               detect::FrameResult r = checker->check(m.positions);
               return Answer{std::move(r.pairs), true,
-                            checker->settings().exact == detect::ExactMode::off ? r.uncertain_tests
-                                                                                : 0};
+                            mode == detect::ExactMode::off ? r.uncertain_tests : 0};
             };
           }};
 }
@@ -197,11 +196,8 @@ Input hard_corpus(const fs::path& dir) {
   }
   for (const auto& [path, weld] : files) {
     mesh::Mesh m = io::read_mesh(path);
-    if (weld) {
-      const std::vector<int32_t> representative = mesh::weld_representatives(m.positions, *weld);
-      for (auto& t : m.triangles)
-        for (int32_t& v : t.v) v = representative[v];
-    }
+    if (weld)
+      m.triangles = mesh::welded_triangles(m.triangles, mesh::weld_representatives(m.positions, *weld));
     input.frames.push_back(std::move(m));
   }
   input.cases = static_cast<int>(input.frames.size());
@@ -290,11 +286,8 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
       "accuracy",
       "Time and score each --exact mode, CGAL and a plain floating-point test on the same frames "
       "against the exact answer");
-  cmd->add_option("--sizes", o.sizes, "Generated cloth sizes in triangles (0 or empty: none)")
-      ->type_name("T,...")
-      ->delimiter(',')
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_case_options(cmd, {&o.sizes, &o.data_dir, &o.inputs, &o.generator, &o.threads},
+                   "its files are inputs", "score");
   cmd->add_option("--frames", o.frames, "Frames per generated cloth")
       ->type_name("N")
       ->check(CLI::PositiveNumber)
@@ -306,20 +299,6 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
   cmd->add_option("--hard", o.hard_dir,
                   "The hard-case corpus (default: samples/hard of the source tree)")
       ->type_name("DIR");
-  cmd->add_option("--data", o.data_dir,
-                  "The shared data folder (default: $SNAG_DATA_DIR, else the one known at build "
-                  "time); its files are inputs when present")
-      ->type_name("DIR");
-  cmd->add_option("--input", o.inputs, "Also score this sequence (repeatable)")
-      ->type_name("SEQUENCE");
-  cmd->add_option("--generator", o.generator,
-                  "The snag-cloth sample generator (default: beside snag, in the build tree, or "
-                  "on PATH)")
-      ->type_name("PATH");
-  cmd->add_option("-j,--threads", o.threads, "CPU worker threads; 0 uses every core")
-      ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)

@@ -32,12 +32,8 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
   CLI::App* gpu = bench.add_subcommand("gpu",
                                        "Time the CUDA backend's stages with CUDA events, next to "
                                        "the CPU backend and the paper's table");
-  gpu->add_option("--sizes", o.sizes,
-                  "Generated cloth sizes in triangles (0 or an empty list: none)")
-      ->type_name("T,...")
-      ->delimiter(',')
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_case_options(gpu, {&o.sizes, &o.data_dir, &o.inputs, &o.generator, &o.threads},
+                   "its cloth-ball and n-body frames are cases", "time");
   gpu->add_option("--large", o.large,
                   "Triangles of the large generated cloth, taken from its first frames (0: none)")
       ->type_name("T")
@@ -54,20 +50,6 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
   gpu->add_option("--cpu-frames", o.cpu_frames, "Timed frames per case on the CPU")
       ->type_name("N")
       ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  gpu->add_option("--data", o.data_dir,
-                  "The shared data folder; its cloth-ball and n-body frames are cases when present "
-                  "(default: $SNAG_DATA_DIR, else the one known at build time)")
-      ->type_name("DIR");
-  gpu->add_option("--input", o.inputs, "Also time this sequence (repeatable)")
-      ->type_name("SEQUENCE");
-  gpu->add_option(
-         "--generator", o.generator,
-         "The snag-cloth sample generator (default: beside snag, in the build tree, or on PATH)")
-      ->type_name("PATH");
-  gpu->add_option("-j,--threads", o.threads, "CPU worker threads; 0 uses every core")
-      ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   gpu->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")

@@ -140,4 +140,28 @@ CaseFrames read_case(const BenchCase& c, std::string_view command) {
   return frames;
 }
 
+void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& data_cases,
+                      const std::string& verb) {
+  cmd->add_option("--sizes", *o.sizes,
+                  "Generated cloth sizes in triangles (0 or an empty list: none)")
+      ->type_name("T,...")
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--data", *o.data_dir,
+                  "The shared data folder; " + data_cases +
+                      " when present (default: $SNAG_DATA_DIR, else the one known at build time)")
+      ->type_name("DIR");
+  cmd->add_option("--input", *o.inputs, "Also " + verb + " this sequence (repeatable)")
+      ->type_name("SEQUENCE");
+  cmd->add_option("--generator", *o.generator,
+                  "The snag-cloth sample generator (default: beside snag, in the build tree, or "
+                  "on PATH)")
+      ->type_name("PATH");
+  cmd->add_option("-j,--threads", *o.threads, "CPU worker threads; 0 uses every core")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
 }  // namespace snag::cli

@@ -1,6 +1,8 @@
 // What the benchmarks share: medians, a scratch directory, the sample generator, the data folder.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -59,6 +61,21 @@ BenchCase sequence_case(std::string name, const std::string& sequence);
 void add_data_case(std::vector<BenchCase>& cases, const std::filesystem::path& data,
                    const std::string& given, const std::string& name, const std::string& folder,
                    std::string_view command);
+
+/// Where a benchmark's cases come from, as every `snag bench` command takes them.
+struct CaseOptions {
+  std::vector<int>* sizes;          ///< --sizes: generated cloth sizes
+  std::string* data_dir;            ///< --data
+  std::vector<std::string>* inputs;  ///< --input, repeatable
+  std::string* generator;           ///< --generator
+  int* threads;                     ///< -j, --threads
+};
+
+/// Adds --sizes, --data, --input, --generator and -j/--threads to `cmd`. `data_cases` says what
+/// the data folder contributes ("its cloth-ball frames are a case"); `verb` what is done to an
+/// --input sequence ("time", "score").
+void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& data_cases,
+                      const std::string& verb);
 
 /// A case's frames, read. Each file is read twice and the second read timed, so that the time
 /// is snag's reader on a file in the page cache, not the disk. Throws InputError unless every

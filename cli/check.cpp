@@ -48,17 +48,6 @@ std::vector<seq::Frame> resolve_frames(const CheckOptions& options) {
   return seq::select_frames(frames, seq::FrameSelection::parse(options.frames));
 }
 
-/// The triangles the checker sees: the file's, with each corner replaced by its weld
-/// representative when welding (geometry then comes from the representative's position).
-std::vector<geom::Tri> welded_triangles(const mesh::Mesh& mesh,
-                                        std::span<const int32_t> representative) {
-  std::vector<geom::Tri> triangles = mesh.triangles;
-  if (representative.empty()) return triangles;
-  for (geom::Tri& t : triangles)
-    for (int32_t& v : t.v) v = representative[v];
-  return triangles;
-}
-
 bool same_faces(const std::vector<geom::Tri>& a, const std::vector<geom::Tri>& b) {
   if (a.size() != b.size()) return false;
   for (size_t i = 0; i < a.size(); ++i)
@@ -273,7 +262,7 @@ int run_check(const CheckOptions& o) {
                            "unwelded seams are reported as intersections (use --weld TOL)");
       }
       file_triangles = mesh.triangles;
-      checker->set_triangles(welded_triangles(mesh, representative), vertex_count);
+      checker->set_triangles(mesh::welded_triangles(mesh.triangles, representative), vertex_count);
     }
     const double read_seconds = next->read_seconds + seconds_since(read_started);
 

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "../validators/src/cgal_predicates.h"
+#include "hard_corpus.h"
 #include "lib/detect_fixture.h"
 #include "snag/detect/result.h"
 #include "snag/io/read_mesh.h"
@@ -671,18 +672,6 @@ inline NearDegenerateSettings near_degenerate_settings(uint32_t seed) {
 
 // ---- The hard-case corpus (samples/hard) ------------------------------------------------------
 
-/// Splits a CSV line on commas (the corpus's tables quote nothing).
-inline std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> fields(1);
-  for (char c : line) {
-    if (c == ',')
-      fields.emplace_back();
-    else if (c != '\r')
-      fields.back() += c;
-  }
-  return fields;
-}
-
 /// One case of the hard corpus: its mesh as the checker sees it (corners replaced by their
 /// weld representatives where the case has a weld) and its written answer.
 struct HardCase {
@@ -695,44 +684,15 @@ struct HardCase {
 /// corpus is absent. Files the table does not list come with CGAL's answer.
 inline std::vector<HardCase> hard_cases() {
   std::vector<HardCase> out;
-  const auto dir = source_dir() / "samples" / "hard";
+  const auto dir = corpus_dir();
   if (!std::filesystem::is_directory(dir)) return out;
-  std::map<std::string, Answer> answers;
   std::set<std::string> listed;
-  std::ifstream expected(dir / "expected.csv");
-  std::string line;
-  std::getline(expected, line);
-  if (expected && line.rfind("case,face_a,face_b,kind", 0) != 0)
-    throw std::runtime_error("samples/hard/expected.csv: unexpected header " + line);
-  while (std::getline(expected, line)) {
-    const auto f = csv_fields(line);
-    if (f.size() < 4) continue;
-    answers[f[0]].pairs.push_back(
-        {std::stoi(f[1]), std::stoi(f[2]),
-         f[3] == "crossing" ? detect::PairKind::crossing : detect::PairKind::touching});
-  }
-  std::ifstream cases(dir / "cases.csv");
-  std::getline(cases, line);
-  if (cases && line.rfind("case,file,weld,degenerate_faces", 0) != 0)
-    throw std::runtime_error("samples/hard/cases.csv: unexpected header " + line);
-  while (std::getline(cases, line)) {
-    const auto f = csv_fields(line);
-    if (f.size() < 4) continue;
-    const mesh::Mesh read = io::read_mesh(dir / f[1]);
-    HardCase c{f[0], {read.positions, read.triangles}, answers[f[0]]};
-    if (!f[2].empty()) {
-      const std::vector<int32_t> rep = mesh::weld_representatives(read.positions, std::stod(f[2]));
-      for (auto& t : c.mesh.triangles)
-        for (int32_t& v : t.v) v = rep[v];
-    }
-    std::istringstream degenerate(f[3]);
-    for (int32_t face; degenerate >> face;) c.expected.degenerate.push_back(face);
-    std::sort(c.expected.pairs.begin(), c.expected.pairs.end(), [](const auto& x, const auto& y) {
-      return std::pair(x.a, x.b) < std::pair(y.a, y.b);
-    });
-    std::sort(c.expected.degenerate.begin(), c.expected.degenerate.end());
-    listed.insert(f[1]);
-    out.push_back(std::move(c));
+  for (const CorpusCase& written : load_corpus()) {
+    LoadedCase loaded = load(written);
+    out.push_back({written.name,
+                   {std::move(loaded.mesh.positions), std::move(loaded.triangles)},
+                   {written.expected, written.degenerate}});
+    listed.insert(written.file);
   }
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir))

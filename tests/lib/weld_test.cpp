@@ -39,6 +39,26 @@ Reps brute_force_representatives(const std::vector<Vec3d>& p, double tol) {
   return rep;
 }
 
+TEST(Weld, WeldedTrianglesTakeEveryCornersRepresentative) {
+  const std::vector<geom::Tri> triangles = {{{0, 1, 2}}, {{3, 4, 5}}};
+  // Vertices 3 and 4 sit on 1 and 2 (a seam exported twice).
+  const std::vector<Vec3d> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0},
+                                        {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  const Reps rep = weld_representatives(positions, 0.0);
+  const std::vector<geom::Tri> welded = welded_triangles(triangles, rep);
+  ASSERT_EQ(welded.size(), 2u);
+  EXPECT_EQ(welded[0].v[0], 0);
+  EXPECT_EQ(welded[0].v[1], 1);
+  EXPECT_EQ(welded[0].v[2], 2);
+  EXPECT_EQ(welded[1].v[0], 1);
+  EXPECT_EQ(welded[1].v[1], 2);
+  EXPECT_EQ(welded[1].v[2], 5);
+  // No representatives: the triangles as they are.
+  const std::vector<geom::Tri> same = welded_triangles(triangles, {});
+  EXPECT_EQ(same[1].v[0], 3);
+  EXPECT_EQ(same[1].v[2], 5);
+}
+
 TEST(Weld, EmptyAndSingle) {
   EXPECT_TRUE(weld_representatives({}, 0.1).empty());
   const std::vector<Vec3d> one = {{1, 2, 3}};

@@ -29,12 +29,6 @@ detect::FrameResult snag_check(std::span<const geom::Vec3d> positions,
   return checker.check(positions);
 }
 
-Pairs ids_of(const std::vector<detect::FacePair>& pairs) {
-  Pairs ids;
-  for (const auto& p : pairs) ids.emplace_back(p.a, p.b);
-  return ids;
-}
-
 void expect_kinds_match(std::span<const geom::Vec3d> positions,
                         std::span<const geom::Tri> triangles,
                         const std::vector<detect::FacePair>& pairs, const std::string& what) {
@@ -99,7 +93,7 @@ TEST(CgalAgreement, LatticeSoupsPairForPairWithExactKinds) {
     const Pairs expected = cgal_soup_self_intersections(soup.positions, soup.triangles);
     for (int threads : {1, 2}) {
       const detect::FrameResult result = snag_check(soup.positions, soup.triangles, threads);
-      ASSERT_EQ(ids_of(result.pairs), expected) << "seed " << seed << " threads " << threads;
+      ASSERT_EQ(pair_ids(result.pairs), expected) << "seed " << seed << " threads " << threads;
       expect_kinds_match(soup.positions, soup.triangles, result.pairs,
                          "seed " + std::to_string(seed));
     }
@@ -115,7 +109,7 @@ TEST(CgalAgreement, SampleSequenceMatchesSelfIntersections) {
     if (entry.path().extension() != ".obj") continue;
     const mesh::Mesh mesh = io::read_mesh(entry.path());
     const detect::FrameResult result = snag_check(mesh.positions, mesh.triangles);
-    ASSERT_EQ(ids_of(result.pairs), cgal_self_intersections(mesh.positions, mesh.triangles))
+    ASSERT_EQ(pair_ids(result.pairs), cgal_self_intersections(mesh.positions, mesh.triangles))
         << entry.path();
     expect_kinds_match(mesh.positions, mesh.triangles, result.pairs, entry.path().string());
     ++frames;
@@ -166,9 +160,8 @@ TEST_P(DataAgreement, MatchesCgalPairForPairAndTheReferenceCount) {
   if (std::filesystem::path(file.path).extension() == ".stl") {
     // STL is a triangle soup: weld exactly coincident corners first (the reference counts
     // are after welding), as `snag check --weld 0` does.
-    const std::vector<int32_t> representative = mesh::weld_representatives(mesh.positions, 0.0);
-    for (auto& t : mesh.triangles)
-      for (int32_t& v : t.v) v = representative[v];
+    mesh.triangles =
+        mesh::welded_triangles(mesh.triangles, mesh::weld_representatives(mesh.positions, 0.0));
   }
   const detect::FrameResult result = snag_check(mesh.positions, mesh.triangles);
   Pairs expected;
@@ -178,7 +171,7 @@ TEST_P(DataAgreement, MatchesCgalPairForPairAndTheReferenceCount) {
     expected = cgal_soup_self_intersections(mesh.positions, mesh.triangles);
   }
   EXPECT_EQ(result.pairs.size(), file.cgal_pairs) << "reference count of ../shared/data/README.md";
-  ASSERT_EQ(ids_of(result.pairs), expected);
+  ASSERT_EQ(pair_ids(result.pairs), expected);
   EXPECT_TRUE(result.degenerate.empty()) << result.degenerate.size() << " degenerate faces";
   if (result.pairs.size() < 20000)
     expect_kinds_match(mesh.positions, mesh.triangles, result.pairs, file.path);

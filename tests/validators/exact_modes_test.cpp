@@ -31,12 +31,6 @@ detect::FrameResult check(std::span<const geom::Vec3d> positions,
   return checker->check(positions);
 }
 
-Pairs ids_of(const std::vector<detect::FacePair>& pairs) {
-  Pairs ids;
-  for (const auto& p : pairs) ids.emplace_back(p.a, p.b);
-  return ids;
-}
-
 struct Soup {
   std::vector<geom::Vec3d> positions;
   std::vector<geom::Tri> triangles;
@@ -76,7 +70,7 @@ TEST(ExactModes, UncertainAndAllAgreeWithEachOtherAndWithCgal) {
       const detect::FrameResult all = check(soup.positions, soup.triangles, ExactMode::all, threads);
       ASSERT_EQ(uncertain.pairs, all.pairs) << what;  // kinds included
       ASSERT_EQ(uncertain.degenerate, all.degenerate) << what;
-      ASSERT_EQ(ids_of(all.pairs), expected) << what;
+      ASSERT_EQ(pair_ids(all.pairs), expected) << what;
       // `all` decided every test exactly and confirmed every pair.
       EXPECT_EQ(all.filtered_tests, 0) << what;
       EXPECT_EQ(all.confirmed_pairs, static_cast<int64_t>(all.pairs.size())) << what;

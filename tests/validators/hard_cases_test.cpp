@@ -6,8 +6,7 @@
 // intersection gives the same kinds; CGAL's exact collinearity test finds the same zero-area faces.
 #include <gtest/gtest.h>
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
-#include <CGAL/intersections.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -26,121 +25,25 @@
 #include "snag/mesh/weld.h"
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/exact_modes.h"
+#include "hard_corpus.h"
 #include "test_paths.h"
 
 namespace snag::validators {
 namespace {
 
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using test::corpus_dir;
+using test::corpus_or_empty;
+using test::load;
+using test::load_corpus;
+using HardCase = test::CorpusCase;
+using Loaded = test::LoadedCase;
+
 namespace fs = std::filesystem;
 using Pairs = std::vector<std::pair<int32_t, int32_t>>;
 
-struct HardCase {
-  std::string name;
-  std::string file;
-  std::string weld;  // empty: no weld
-  std::vector<int32_t> degenerate;
-  std::string description;
-  std::vector<detect::FacePair> expected;  // sorted by (a, b)
-};
-
 void PrintTo(const HardCase& c, std::ostream* os) {
   *os << c.name;
-}
-
-fs::path corpus_dir() {
-  return test::source_dir() / "samples" / "hard";
-}
-
-std::vector<std::string> split_csv_line(const std::string& line, size_t fields) {
-  // The corpus has no quoted fields: the generator rejects commas in descriptions.
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (out.size() + 1 < fields) {
-    const size_t comma = line.find(',', start);
-    if (comma == std::string::npos) break;
-    out.push_back(line.substr(start, comma - start));
-    start = comma + 1;
-  }
-  out.push_back(line.substr(start));
-  return out;
-}
-
-std::vector<std::string> csv_rows(const fs::path& path, const std::string& header) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path.string());
-  std::vector<std::string> rows;
-  std::string line;
-  if (!std::getline(in, line) || line != header)
-    throw std::runtime_error(path.string() + ": expected the header '" + header + "', found '" +
-                             line + "'");
-  while (std::getline(in, line))
-    if (!line.empty()) rows.push_back(line);
-  return rows;
-}
-
-/// The corpus as written down; throws with the file and row on anything malformed.
-std::vector<HardCase> load_corpus() {
-  std::vector<HardCase> cases;
-  std::map<std::string, size_t> index;
-  for (const std::string& row :
-       csv_rows(corpus_dir() / "cases.csv", "case,file,weld,degenerate_faces,description")) {
-    const auto f = split_csv_line(row, 5);
-    if (f.size() != 5) throw std::runtime_error("cases.csv: row '" + row + "' has not 5 fields");
-    HardCase c{f[0], f[1], f[2], {}, f[4], {}};
-    std::istringstream ids(f[3]);
-    for (int32_t id; ids >> id;) c.degenerate.push_back(id);
-    if (!index.emplace(c.name, cases.size()).second)
-      throw std::runtime_error("cases.csv: case " + c.name + " listed twice");
-    cases.push_back(std::move(c));
-  }
-  for (const std::string& row :
-       csv_rows(corpus_dir() / "expected.csv", "case,face_a,face_b,kind")) {
-    const auto f = split_csv_line(row, 4);
-    const auto it = f.size() == 4 ? index.find(f[0]) : index.end();
-    if (it == index.end())
-      throw std::runtime_error("expected.csv: row '" + row + "' names no case of cases.csv");
-    detect::FacePair p{std::stoi(f[1]), std::stoi(f[2]), detect::PairKind::touching};
-    if (f[3] == "crossing")
-      p.kind = detect::PairKind::crossing;
-    else if (f[3] != "touching")
-      throw std::runtime_error("expected.csv: row '" + row + "': kind is not crossing/touching");
-    if (!(0 <= p.a && p.a < p.b))
-      throw std::runtime_error("expected.csv: row '" + row + "': expected 0 <= face_a < face_b");
-    cases[it->second].expected.push_back(p);
-  }
-  for (HardCase& c : cases)
-    std::sort(c.expected.begin(), c.expected.end(), [](const auto& x, const auto& y) {
-      return std::pair(x.a, x.b) < std::pair(y.a, y.b);
-    });
-  return cases;
-}
-
-/// Empty (and the corpus test fails) when the corpus cannot be read.
-std::vector<HardCase> corpus_or_empty() {
-  try {
-    return load_corpus();
-  } catch (const std::exception&) {
-    return {};
-  }
-}
-
-/// The case's mesh and the triangles the checker sees: corners replaced by their weld
-/// representatives when the case has a weld, as `snag check --weld` does.
-struct Loaded {
-  mesh::Mesh mesh;
-  std::vector<geom::Tri> triangles;
-};
-
-Loaded load(const HardCase& c) {
-  Loaded out{io::read_mesh(corpus_dir() / c.file), {}};
-  out.triangles = out.mesh.triangles;
-  if (!c.weld.empty()) {
-    const std::vector<int32_t> rep =
-        mesh::weld_representatives(out.mesh.positions, std::stod(c.weld));
-    for (geom::Tri& t : out.triangles)
-      for (int32_t& v : t.v) v = rep[v];
-  }
-  return out;
 }
 
 std::string describe(const std::vector<detect::FacePair>& pairs) {
@@ -163,38 +66,9 @@ std::string describe(const std::vector<int32_t>& ids) {
   return ids.empty() ? "(none)" : s;
 }
 
-Pairs ids_of(const std::vector<detect::FacePair>& pairs) {
-  Pairs ids;
-  for (const auto& p : pairs) ids.emplace_back(p.a, p.b);
-  return ids;
-}
-
-using EK = CGAL::Exact_predicates_exact_constructions_kernel;
-
-EK::Point_3 point(const mesh::Mesh& m, int32_t v) {
+Kernel::Point_3 point(const mesh::Mesh& m, int32_t v) {
   const geom::Vec3d& p = m.positions[v];
   return {p.x, p.y, p.z};
-}
-
-/// The kind from CGAL's exact construction of the intersection (BRIEF's definition).
-detect::PairKind cgal_kind(const Loaded& l, const geom::Tri& f, const geom::Tri& g) {
-  auto P = [&](int32_t v) { return point(l.mesh, v); };
-  const EK::Triangle_3 tf(P(f.v[0]), P(f.v[1]), P(f.v[2])), tg(P(g.v[0]), P(g.v[1]), P(g.v[2]));
-  auto straddles = [&](const EK::Triangle_3& t, const geom::Tri& other) {
-    bool pos = false, neg = false;
-    for (int i = 0; i < 3; ++i) {
-      const auto o = CGAL::orientation(t[0], t[1], t[2], P(other.v[i]));
-      pos |= o == CGAL::POSITIVE;
-      neg |= o == CGAL::NEGATIVE;
-    }
-    return pos && neg;
-  };
-  if (!straddles(tf, g) || !straddles(tg, f)) return detect::PairKind::touching;
-  const auto result = CGAL::intersection(tf, tg);
-  if (!result) return detect::PairKind::touching;
-  if (const EK::Segment_3* s = boost::get<EK::Segment_3>(&*result); s && !s->is_degenerate())
-    return detect::PairKind::crossing;
-  return detect::PairKind::touching;
 }
 
 // Cases CGAL's halfedge mesh cannot hold (a face repeating another's three vertices in the same
@@ -242,7 +116,7 @@ TEST_P(HardCases, ExactOffIsRightWhenItDecidedNothingByRounding) {
 TEST_P(HardCases, CgalFindsTheWrittenPairs) {
   const HardCase& c = GetParam();
   const Loaded l = load(c);
-  const Pairs written = ids_of(c.expected);
+  const Pairs written = pair_ids(c.expected);
   const Pairs soup = cgal_soup_self_intersections(l.mesh.positions, l.triangles);
   EXPECT_EQ(soup, written) << c.name << ": CGAL's rules pair by pair\n  CGAL:    " << describe(soup)
                            << "\n  written: " << describe(written);
@@ -263,7 +137,7 @@ TEST_P(HardCases, CgalExactKindsAndDegenerateFacesMatch) {
   const auto n = static_cast<int32_t>(l.triangles.size());
   for (const auto& p : c.expected) {
     ASSERT_LT(p.b, n) << c.name << ": pair " << p.a << "-" << p.b << " names no face";
-    EXPECT_EQ(cgal_kind(l, l.triangles[p.a], l.triangles[p.b]), p.kind)
+    EXPECT_EQ(cgal_pair_kind(l.mesh.positions, l.triangles[p.a], l.triangles[p.b]), p.kind)
         << c.name << ": pair " << p.a << "-" << p.b << " written as " << to_string(p.kind);
   }
   std::vector<int32_t> collinear;

@@ -38,6 +38,13 @@ void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
 
 }  // namespace
 
+std::vector<std::pair<int32_t, int32_t>> pair_ids(std::span<const detect::FacePair> pairs) {
+  std::vector<std::pair<int32_t, int32_t>> ids;
+  ids.reserve(pairs.size());
+  for (const detect::FacePair& p : pairs) ids.emplace_back(p.a, p.b);
+  return ids;
+}
+
 bool cgal_faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
                           const geom::Tri& g) {
   int shared = 0, fi = -1, gi = -1;

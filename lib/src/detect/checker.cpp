@@ -140,8 +140,9 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
       std::vector<uint8_t> degenerate_flags(static_cast<size_t>(topology_->triangle_count()), 0);
       for (int32_t t : result.degenerate) degenerate_flags[t] = 1;
       std::vector<FacePair> found = expand_hits(*topology_, hits, degenerate_flags);
-      std::vector<uint8_t> certain;
-      classify_pairs(positions, *topology_, found, certain, 1);
+      // Their kinds: by the filter where it can, unless `all` decides every kind below.
+      std::vector<uint8_t> certain(found.size(), 0);
+      if (!exact_all) classify_pairs(positions, *topology_, found, certain, 1);
       merge_pairs(frame.pairs, frame.kind_certain, found, certain);
     }
   }

@@ -176,4 +176,13 @@ int64_t count_coincident_vertices(std::span<const geom::Vec3d> positions) {
   return count;
 }
 
+std::vector<geom::Tri> welded_triangles(std::span<const geom::Tri> triangles,
+                                        std::span<const int32_t> representative) {
+  std::vector<geom::Tri> welded(triangles.begin(), triangles.end());
+  if (representative.empty()) return welded;
+  for (geom::Tri& t : welded)
+    for (int32_t& v : t.v) v = representative[v];
+  return welded;
+}
+
 }  // namespace snag::mesh

@@ -18,6 +18,11 @@ namespace snag::mesh {
 /// when `tolerance` is negative or not finite. O(n log n) with a uniform grid of cell 2*tol.
 std::vector<int32_t> weld_representatives(std::span<const geom::Vec3d> positions, double tolerance);
 
+/// The triangles with every corner replaced by its representative (weld_representatives), which
+/// is how welding joins triangles for adjacency; `representative` empty: the triangles as they are.
+std::vector<geom::Tri> welded_triangles(std::span<const geom::Tri> triangles,
+                                        std::span<const int32_t> representative);
+
 /// The number of vertices whose position exactly equals that of a vertex with a smaller id
 /// (what `--weld` would join at tolerance 0); 0 for a mesh without coincident vertices.
 int64_t count_coincident_vertices(std::span<const geom::Vec3d> positions);

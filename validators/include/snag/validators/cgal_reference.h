@@ -50,6 +50,9 @@ class CgalSequence {
 std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
     std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
 
+/// snag's pairs as CGAL's answers above give them: (a, b) ids, in the same order.
+std::vector<std::pair<int32_t, int32_t>> pair_ids(std::span<const detect::FacePair> pairs);
+
 /// One pair under those rules: do non-degenerate triangles f and g (shared vertices by id)
 /// intersect beyond what their shared vertices explain?
 bool cgal_faces_intersect(std::span<const geom::Vec3d> positions, const geom::Tri& f,
