@@ -297,7 +297,8 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--hard", o.hard_dir,
-                  "The hard-case corpus (default: samples/hard of the source tree)")
+                  "The hard-case corpus (default: samples/hard of $SNAG_SOURCE_DIR, else of the source tree "
+                  "known at build time)")
       ->type_name("DIR");
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
