@@ -15,6 +15,7 @@
 #include "file_buffer.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
+#include "structure_cache.h"
 #include "text_scan.h"
 
 namespace snag::io {
@@ -26,11 +27,19 @@ using detail::quote_token;
 
 class ObjParser {
  public:
-  ObjParser(std::string_view text, const std::string& name)
-      : p_(text.data()), end_(text.data() + text.size()), name_(name) {}
+  ObjParser(std::string_view text, const std::string& name, detail::StructureCache* cache)
+      : p_(text.data()), end_(text.data() + text.size()), name_(name), cache_(cache) {}
 
   mesh::Mesh parse() {
-    reserve();
+    if (cache_ && cache_->valid) {
+      // Most likely the remembered layout: its sizes, without the counting pass.
+      mesh_.positions.reserve(static_cast<size_t>(cache_->vertex_count));
+      mesh_.triangles.reserve(cache_->structure.triangles.size());
+      mesh_.source_polygon.reserve(cache_->structure.triangles.size());
+      mesh_.triangle_group.reserve(cache_->structure.triangles.size());
+    } else {
+      reserve();
+    }
     while (p_ < end_) {
       while (p_ < end_ && is_blank(*p_)) ++p_;
       if (p_ == end_) break;
@@ -44,7 +53,11 @@ class ObjParser {
       if (keyword_alone) {
         if (c == 'v') {
           parse_vertex();
-        } else if (c == 'f') {
+          skip_line();
+          if (tail_matches_cache()) return std::move(mesh_);
+          continue;
+        }
+        if (c == 'f') {
           parse_face();
         } else if (c == 'o' || c == 'g') {
           parse_group();
@@ -53,6 +66,12 @@ class ObjParser {
       skip_line();
     }
     check_forward_references();
+    if (cache_) {
+      if (tail_start_)
+        cache_->store({}, tail_pending_, tail_pending_name_, tail_start_, end_, mesh_);
+      else
+        cache_->clear();
+    }
     return std::move(mesh_);
   }
 
@@ -78,6 +97,25 @@ class ObjParser {
   }
 
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
+
+  /// Called at the end of every vertex line. While no face has been listed, the rest of the
+  /// file could be the tail of structure_cache.h: remember where it starts and the pending
+  /// group name (the only parser state that carries into faces before any face), and when it
+  /// is the cached frame's tail, take that frame's structure instead of parsing it again.
+  bool tail_matches_cache() {
+    if (mesh_.polygon_count != 0) {
+      tail_start_ = nullptr;  // a vertex after a face: this layout is not cached
+      return false;
+    }
+    tail_start_ = p_;
+    tail_pending_ = group_pending_;
+    tail_pending_name_ = pending_name_;
+    if (!cache_ || !cache_->matches({}, static_cast<int64_t>(mesh_.positions.size()),
+                                    group_pending_, pending_name_, p_, end_))
+      return false;
+    cache_->apply(mesh_);
+    return true;
+  }
 
   void skip_line() {
     // A parsed `v` or `f` line usually stops right at its end: no memchr call needed.
@@ -248,13 +286,24 @@ class ObjParser {
   bool group_pending_ = false;
   int32_t group_ = -1;
   std::unordered_map<std::string, int32_t> group_ids_;
+  detail::StructureCache* cache_;     // null: no reuse
+  const char* tail_start_ = nullptr;  // after the last vertex line, if no face precedes it
+  bool tail_pending_ = false;
+  std::string_view tail_pending_name_;
 };
 
 }  // namespace
 
 mesh::Mesh read_obj(std::string_view text, const std::string& name_for_errors) {
-  return ObjParser(text, name_for_errors).parse();
+  return ObjParser(text, name_for_errors, nullptr).parse();
 }
+
+namespace detail {
+mesh::Mesh read_obj_reusing(std::string_view text, const std::string& name_for_errors,
+                            StructureCache& cache) {
+  return ObjParser(text, name_for_errors, &cache).parse();
+}
+}  // namespace detail
 
 mesh::Mesh read_obj_file(const std::filesystem::path& path) {
   return read_obj(detail::read_into_thread_buffer(path), path.string());

@@ -17,6 +17,7 @@
 #include "file_buffer.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
+#include "structure_cache.h"
 #include "text_scan.h"
 
 namespace snag::io {
@@ -305,31 +306,71 @@ std::string record_name(const Element& el, int64_t i) {
   return el.name + " " + std::to_string(i) + " (of " + std::to_string(el.count) + ")";
 }
 
+/// Reuse of an earlier frame's structure (structure_cache.h), shared by both encodings. The
+/// prefix is the header (element counts, types, encoding); the tail is everything after the
+/// vertex element, which must come before the face element for the tail to hold the faces.
+class StructureReuse {
+ public:
+  StructureReuse(detail::StructureCache* cache, std::string_view header)
+      : cache_(cache), header_(header) {}
+
+  /// Called once the vertex element `e` is read, `rest` being the next byte: true when the
+  /// rest of the file is the cached tail, `mesh` then having the cached structure.
+  bool after_vertices(const Plan& plan, size_t e, const char* rest, const char* end,
+                      mesh::Mesh& mesh) {
+    if (!cache_ || plan.face_element < static_cast<int>(e)) return false;
+    tail_start_ = rest;
+    if (!cache_->matches(header_, static_cast<int64_t>(mesh.positions.size()), false, {}, rest,
+                         end))
+      return false;
+    cache_->apply(mesh);
+    return true;
+  }
+
+  /// Called after a parse in full: remembers this file for the next one.
+  void parsed_in_full(const char* end, const mesh::Mesh& mesh) {
+    if (!cache_) return;
+    if (tail_start_)
+      cache_->store(header_, false, {}, tail_start_, end, mesh);
+    else
+      cache_->clear();
+  }
+
+ private:
+  detail::StructureCache* cache_;  // null: no reuse
+  std::string_view header_;
+  const char* tail_start_ = nullptr;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Binary body.
 
 template <bool Swap>
 class BinaryBody {
  public:
-  BinaryBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name)
+  BinaryBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name,
+             detail::StructureCache* cache)
       : base_(bytes.data()),
         p_(bytes.data() + h.body_offset),
         end_(bytes.data() + bytes.size()),
         h_(h),
         plan_(plan),
-        name_(name) {}
+        name_(name),
+        reuse_(cache, bytes.substr(0, h.body_offset)) {}
 
   mesh::Mesh parse() {
     for (size_t e = 0; e < h_.elements.size(); ++e) {
       const Element& el = h_.elements[e];
       if (static_cast<int>(e) == plan_.vertex_element) {
         read_vertices(el);
+        if (reuse_.after_vertices(plan_, e, p_, end_, mesh_)) return std::move(mesh_);
       } else if (static_cast<int>(e) == plan_.face_element) {
         read_faces(el);
       } else {
         skip_element(el);
       }
     }
+    reuse_.parsed_in_full(end_, mesh_);
     return std::move(mesh_);
   }
 
@@ -561,6 +602,7 @@ class BinaryBody {
   const std::string& name_;
   mesh::Mesh mesh_;
   std::vector<int32_t> corners_;
+  StructureReuse reuse_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -569,13 +611,15 @@ class BinaryBody {
 
 class AsciiBody {
  public:
-  AsciiBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name)
+  AsciiBody(std::string_view bytes, const Header& h, const Plan& plan, const std::string& name,
+            detail::StructureCache* cache)
       : p_(bytes.data() + h.body_offset),
         end_(bytes.data() + bytes.size()),
         line_(h.body_line),
         h_(h),
         plan_(plan),
-        name_(name) {}
+        name_(name),
+        reuse_(cache, bytes.substr(0, h.body_offset)) {}
 
   mesh::Mesh parse() {
     for (size_t e = 0; e < h_.elements.size(); ++e) {
@@ -603,7 +647,9 @@ class AsciiBody {
         }
       }
       if (is_face) mesh_.polygon_count = el.count;
+      if (is_vertex && reuse_.after_vertices(plan_, e, p_, end_, mesh_)) return std::move(mesh_);
     }
+    reuse_.parsed_in_full(end_, mesh_);
     return std::move(mesh_);
   }
 
@@ -711,30 +757,43 @@ class AsciiBody {
   const std::string& name_;
   mesh::Mesh mesh_;
   std::vector<int32_t> corners_;
+  StructureReuse reuse_;
 };
 
-}  // namespace
-
-mesh::Mesh read_ply(std::string_view bytes, const std::string& name_for_errors) {
+mesh::Mesh parse_ply(std::string_view bytes, const std::string& name_for_errors,
+                     detail::StructureCache* cache) {
   const Header header = parse_header(bytes, name_for_errors);
   const Plan plan = make_plan(header, name_for_errors);
   constexpr bool host_little = std::endian::native == std::endian::little;
   switch (header.format) {
     case Format::ascii:
-      return AsciiBody(bytes, header, plan, name_for_errors).parse();
+      return AsciiBody(bytes, header, plan, name_for_errors, cache).parse();
     case Format::binary_little_endian:
       if constexpr (host_little)
-        return BinaryBody<false>(bytes, header, plan, name_for_errors).parse();
+        return BinaryBody<false>(bytes, header, plan, name_for_errors, cache).parse();
       else
-        return BinaryBody<true>(bytes, header, plan, name_for_errors).parse();
+        return BinaryBody<true>(bytes, header, plan, name_for_errors, cache).parse();
     case Format::binary_big_endian:
       if constexpr (host_little)
-        return BinaryBody<true>(bytes, header, plan, name_for_errors).parse();
+        return BinaryBody<true>(bytes, header, plan, name_for_errors, cache).parse();
       else
-        return BinaryBody<false>(bytes, header, plan, name_for_errors).parse();
+        return BinaryBody<false>(bytes, header, plan, name_for_errors, cache).parse();
   }
   throw InternalError("unreachable PLY format");
 }
+
+}  // namespace
+
+mesh::Mesh read_ply(std::string_view bytes, const std::string& name_for_errors) {
+  return parse_ply(bytes, name_for_errors, nullptr);
+}
+
+namespace detail {
+mesh::Mesh read_ply_reusing(std::string_view bytes, const std::string& name_for_errors,
+                            StructureCache& cache) {
+  return parse_ply(bytes, name_for_errors, &cache);
+}
+}  // namespace detail
 
 mesh::Mesh read_ply_file(const std::filesystem::path& path) {
   return read_ply(detail::read_into_thread_buffer(path), path.string());

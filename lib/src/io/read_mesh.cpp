@@ -14,6 +14,7 @@
 #include "snag/io/assimp_reader.h"
 #include "snag/io/obj_reader.h"
 #include "snag/io/ply_reader.h"
+#include "structure_cache.h"
 
 namespace snag::io {
 namespace {
@@ -121,6 +122,24 @@ std::string_view read_into_thread_buffer(const std::filesystem::path& path) {
 }
 
 }  // namespace detail
+
+FrameReader::FrameReader() : cache_(std::make_unique<detail::StructureCache>()) {}
+FrameReader::~FrameReader() = default;
+FrameReader::FrameReader(FrameReader&&) noexcept = default;
+FrameReader& FrameReader::operator=(FrameReader&&) noexcept = default;
+
+mesh::Mesh FrameReader::read(const std::filesystem::path& path) {
+  const std::string ext = lowercase_extension(path);
+  if (ext == ".obj")
+    return detail::read_obj_reusing(detail::read_into_thread_buffer(path), path.string(), *cache_);
+  if (ext == ".ply")
+    return detail::read_ply_reusing(detail::read_into_thread_buffer(path), path.string(), *cache_);
+  return read_mesh(path);
+}
+
+int64_t FrameReader::frames_reused() const {
+  return cache_->reused;
+}
 
 mesh::Mesh read_mesh(const std::filesystem::path& path) {
   const std::string ext = lowercase_extension(path);

@@ -1,7 +1,9 @@
 // Reading one frame file into a Mesh, whatever its format.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "snag/mesh/mesh.h"
@@ -14,6 +16,32 @@ namespace snag::io {
 /// says so (`ids_from_assimp`). Throws snag::InputError naming the file, the line or byte
 /// offset, what was found and what was expected.
 mesh::Mesh read_mesh(const std::filesystem::path& path);
+
+namespace detail {
+struct StructureCache;
+}
+
+/// Reads the frames of a sequence one after another, as read_mesh does, parsing in full only
+/// what changes. A simulator rewrites positions and nothing else, so a frame whose bytes past
+/// its vertices (its faces, polygons and groups) are those of the last frame this reader
+/// parsed in full, under the same PLY header, has only its positions parsed and takes that
+/// frame's structure: a memcmp where faces were parsed. Any difference is parsed in full, so
+/// results and errors are read_mesh's, whatever the files. One reader per thread.
+class FrameReader {
+ public:
+  FrameReader();
+  ~FrameReader();
+  FrameReader(FrameReader&&) noexcept;
+  FrameReader& operator=(FrameReader&&) noexcept;
+
+  mesh::Mesh read(const std::filesystem::path& path);
+
+  /// Frames that took their structure from an earlier frame instead of parsing it.
+  int64_t frames_reused() const;
+
+ private:
+  std::unique_ptr<detail::StructureCache> cache_;
+};
 
 /// The whole file in one read (the readers parse from memory). Throws snag::InputError when the
 /// file cannot be opened or read.
