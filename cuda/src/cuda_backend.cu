@@ -51,9 +51,15 @@ class CudaBackendImpl final : public CudaBackend {
     SNAG_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
     device_name_ = prop.name;
     stream_ = std::make_unique<Stream>();
+    upload_stream_ = std::make_unique<Stream>();
     configure_kernels();
     counters_.reserve(1);
     counters_host_.reserve(1);
+  }
+
+  ~CudaBackendImpl() override {
+    // A staged copy may still be reading a pinned buffer that is about to be freed.
+    if (upload_stream_) cudaStreamSynchronize(upload_stream_->get());
   }
 
   std::string_view name() const override { return "cuda"; }
@@ -72,6 +78,7 @@ class CudaBackendImpl final : public CudaBackend {
   double stop_timer() override { return span_timer_.stop(stream()); }
 
   void set_topology(const detect::Topology& topology) override {
+    drop_staged_positions();  // its buffers may be reallocated below
     topology_ = &topology;
     const cudaStream_t s = stream();
     DeviceTopology& d = topo_;
@@ -103,9 +110,11 @@ class CudaBackendImpl final : public CudaBackend {
     host_results_ = {mapped(host_keys_.data()), mapped(host_status_.data()),
                      mapped(host_uncertain_.data()), mapped(counters_host_.data()), 0};
     planes_.reserve(std::max<size_t>(n, 1));
-    positions_.reserve(std::max<int32_t>(d.vertex_count, 1));
-    positions_host_.reserve(std::max<int32_t>(d.vertex_count, 1));
-    current_positions_ = positions_.data();
+    for (int slot = 0; slot < 2; ++slot) {
+      positions_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
+      positions_host_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
+    }
+    current_positions_ = positions_[positions_slot_].data();
     pair_bits_ = bits_for(d.triangle_count);
     edge_bits_ = bits_for(d.edge_count);
     tree_.resize(d.triangle_count);
@@ -121,17 +130,51 @@ class CudaBackendImpl final : public CudaBackend {
     if (static_cast<int64_t>(positions.size()) != topo_.vertex_count)
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
-    // The pinned buffer is free once the previous upload is done (detect and scan end with a
-    // sync, so this wait is empty in a checker's frame).
-    if (upload_pending_) upload_timer_.elapsed();
-    std::memcpy(positions_host_.data(), positions.data(), positions.size_bytes());
-    upload_timer_.start(stream());
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_.data(), positions_host_.data(),
-                                    positions.size_bytes(), cudaMemcpyHostToDevice, stream()));
-    upload_timer_.stop_async(stream());
-    upload_pending_ = true;
-    current_positions_ = positions_.data();
+    const int slot = 1 - positions_slot_;
+    if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_) {
+      // Copied across while the previous frame was checked: the stream only waits for the copy.
+      staged_ = false;
+      staged_ready_.wait_on(stream());
+      upload_pending_ = false;
+      times_.upload = 0;
+    } else {
+      drop_staged_positions();
+      // The pinned buffer is free once its last copy is done (long ago in a checker's frame).
+      pinned_copied_[slot].synchronize();
+      std::memcpy(positions_host_[slot].data(), positions.data(), positions.size_bytes());
+      upload_timer_.start(stream());
+      SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data(), positions_host_[slot].data(),
+                                      positions.size_bytes(), cudaMemcpyHostToDevice, stream()));
+      upload_timer_.stop_async(stream());
+      pinned_copied_[slot].record(stream());
+      upload_pending_ = true;
+    }
+    positions_slot_ = slot;
+    current_positions_ = positions_[slot].data();
     ++positions_version_;
+  }
+
+  /// The next frame's positions go into the slot the current frame does not use, on their own
+  /// stream: the host copy into pinned memory now, while the device works on the current
+  /// frame, and the transfer alongside its kernels. That slot held the previous frame, whose
+  /// work is all queued before this point on the main stream: the copy waits for it.
+  void stage_positions(std::span<const geom::Vec3d> next) override {
+    require_topology();
+    if (static_cast<int64_t>(next.size()) != topo_.vertex_count) return;  // not a next frame
+    drop_staged_positions();
+    const int slot = 1 - positions_slot_;
+    const cudaStream_t upload = upload_stream_->get();
+    pinned_copied_[slot].synchronize();
+    std::memcpy(positions_host_[slot].data(), next.data(), next.size_bytes());
+    slot_released_.record(stream());
+    slot_released_.wait_on(upload);
+    SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data(), positions_host_[slot].data(),
+                                    next.size_bytes(), cudaMemcpyHostToDevice, upload));
+    pinned_copied_[slot].record(upload);
+    staged_ready_.record(upload);
+    staged_ = true;
+    staged_data_ = next.data();
+    staged_size_ = next.size();
   }
 
   void upload_resident_frames(std::span<const std::span<const geom::Vec3d>> frames) override {
@@ -249,11 +292,18 @@ class CudaBackendImpl final : public CudaBackend {
     return boxes;
   }
 
-  detect::FilteredFrame detect(std::span<const int32_t> degenerate,
-                               detect::FilterUse use) override;
+  detect::FilteredFrame detect(std::span<const int32_t> degenerate, detect::FilterUse use) override;
 
  private:
   cudaStream_t stream() const { return stream_->get(); }
+
+  /// Forgets a staged frame that was not the next one set, once its copy (which writes the
+  /// slot a new frame will use) is done.
+  void drop_staged_positions() {
+    if (!staged_) return;
+    staged_ = false;
+    upload_stream_->synchronize();
+  }
 
   void require_topology() const {
     if (!topology_) throw InternalError("cuda backend: no topology set");
@@ -310,8 +360,18 @@ class CudaBackendImpl final : public CudaBackend {
   const detect::Topology* topology_ = nullptr;
   DeviceTopology topo_;
   DeviceTree tree_;
-  DeviceBuffer<geom::Vec3d> positions_, resident_;
-  PinnedBuffer<geom::Vec3d> positions_host_;
+  // Positions in two slots, so that the next frame is copied in while the current one is
+  // checked (stage_positions); positions_slot_ is the current frame's.
+  DeviceBuffer<geom::Vec3d> positions_[2], resident_;
+  PinnedBuffer<geom::Vec3d> positions_host_[2];
+  int positions_slot_ = 0;
+  std::unique_ptr<Stream> upload_stream_;
+  Event pinned_copied_[2];  // the last copy out of each pinned buffer
+  Event slot_released_;     // main-stream work queued before a staged copy
+  Event staged_ready_;      // the staged copy
+  bool staged_ = false;
+  const geom::Vec3d* staged_data_ = nullptr;  // the staged frame, as the caller holds it
+  size_t staged_size_ = 0;
   const geom::Vec3d* current_positions_ = nullptr;
   int resident_count_ = 0;
   DeviceBuffer<geom::PlaneCoefficients> planes_;
@@ -419,8 +479,7 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     SNAG_CUDA_CHECK(
         cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
     launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(),
-                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, use,
-                        s);
+                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, use, s);
     narrow_timer_.stop_async(s);
     launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
                   counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),

@@ -103,6 +103,27 @@ class Stream {
   cudaStream_t stream_ = nullptr;
 };
 
+/// A CUDA event without timing, for ordering work between streams and with the host.
+class Event {
+ public:
+  Event() { SNAG_CUDA_CHECK(cudaEventCreateWithFlags(&event_, cudaEventDisableTiming)); }
+  ~Event() {
+    if (event_) cudaEventDestroy(event_);
+  }
+  Event(const Event&) = delete;
+  Event& operator=(const Event&) = delete;
+  void record(cudaStream_t stream) { SNAG_CUDA_CHECK(cudaEventRecord(event_, stream)); }
+  /// Makes `stream` wait (on the device) for the work before the last record().
+  void wait_on(cudaStream_t stream) const {
+    SNAG_CUDA_CHECK(cudaStreamWaitEvent(stream, event_, 0));
+  }
+  /// Waits on the host; returns at once when never recorded.
+  void synchronize() const { SNAG_CUDA_CHECK(cudaEventSynchronize(event_)); }
+
+ private:
+  cudaEvent_t event_ = nullptr;
+};
+
 /// Times work on a stream with two CUDA events: start(), then stop() returns milliseconds
 /// (it waits for the stream to reach the stop event).
 class EventTimer {

@@ -11,8 +11,8 @@
 #include <random>
 
 #include "detect_cases.h"
-#include "snag/bvh/tree.h"
 #include "require_gpu.h"
+#include "snag/bvh/tree.h"
 #include "snag/cuda/cuda_backend.h"
 #include "snag/detect/cpu_backend.h"
 #include "snag/error.h"
@@ -359,8 +359,8 @@ TEST(CudaDetect, ExactModesMatchTheCpuAndBruteForce) {
         return checker.check(mesh.positions);
       };
       const detect::FrameResult gpu = run(gpu_backend()), cpu = run(detect::make_cpu_backend(2));
-      const std::string what = "seed " + std::to_string(seed) + " mode " +
-                               std::string(detect::to_string(mode));
+      const std::string what =
+          "seed " + std::to_string(seed) + " mode " + std::string(detect::to_string(mode));
       EXPECT_EQ(gpu.pairs, cpu.pairs) << what;
       EXPECT_EQ(gpu.degenerate, cpu.degenerate) << what;
       EXPECT_EQ(gpu.uncertain_tests, cpu.uncertain_tests) << what;
@@ -400,6 +400,52 @@ TEST(CudaBackend, ResidentFramesGiveTheSameResultsAsUploadedOnes) {
     const Filtered u = filtered(*uploaded, f == 0 ? a.positions : b.positions, true);
     EXPECT_EQ(r.pairs, u.frame.pairs) << f;
     EXPECT_EQ(r.uncertain, u.frame.uncertain) << f;
+  }
+}
+
+TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
+  SNAG_REQUIRE_GPU();
+  // A sequence checked with each next frame staged while the current one is checked, against
+  // the CPU and brute force: staged frames used, a staged frame replaced by another, staging
+  // skipped, a topology change after staging, and a big frame (copies long enough to overlap
+  // the kernels) all give the plain answers.
+  SmallMesh base = folded_grid(60, 20);
+  std::vector<SmallMesh> frames;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int f = 0; f < 12; ++f) {
+    frames.push_back(base);
+    for (auto& p : base.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+  }
+  auto resolver = std::make_shared<IntegerResolver>();
+  detect::Checker gpu(gpu_backend(), resolver);
+  detect::Checker cpu(detect::make_cpu_backend(2), resolver);
+  const int32_t vertices = static_cast<int32_t>(base.positions.size());
+  for (detect::Checker* c : {&gpu, &cpu}) c->set_triangles(base.triangles, vertices);
+  SmallMesh unrelated = frames[3];
+  for (auto& p : unrelated.positions) p = p + geom::Vec3d{1, 0, 0};
+  std::vector<geom::Tri> reversed = base.triangles;
+  std::reverse(reversed.begin(), reversed.end());
+  for (int f = 0; f < 12; ++f) {
+    std::span<const geom::Vec3d> next;
+    if (f + 1 < 12 && f != 4) next = frames[f + 1].positions;  // frame 5 arrives unstaged
+    if (f == 7) next = unrelated.positions;  // staged, then not the frame that comes
+    if (f == 9) {
+      // A new face order after frame 9 was staged: the staged copy is dropped.
+      const detect::FrameResult g = gpu.check(frames[f].positions, frames[f + 1].positions);
+      EXPECT_EQ(g.pairs, cpu.check(frames[f].positions).pairs) << "frame " << f;
+      for (detect::Checker* c : {&gpu, &cpu}) c->set_triangles(reversed, vertices);
+      for (SmallMesh* m : {&frames[10], &frames[11]}) m->triangles = reversed;
+      continue;
+    }
+    const detect::FrameResult g = gpu.check(frames[f].positions, next);
+    const detect::FrameResult c = cpu.check(frames[f].positions);
+    EXPECT_EQ(g.pairs, c.pairs) << "frame " << f;
+    EXPECT_EQ(g.degenerate, c.degenerate) << "frame " << f;
+    EXPECT_EQ(g.candidate_pairs, c.candidate_pairs) << "frame " << f;
+    EXPECT_EQ(g.tree_quality, c.tree_quality) << "frame " << f;
+    EXPECT_EQ(g.pairs, brute_force(frames[f])) << "frame " << f;
   }
 }
 

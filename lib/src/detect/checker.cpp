@@ -49,7 +49,8 @@ bool Checker::set_triangles(std::span<const geom::Tri> triangles, int32_t vertex
   return true;
 }
 
-FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
+FrameResult Checker::check(std::span<const geom::Vec3d> positions,
+                           std::span<const geom::Vec3d> next_positions) {
   if (!topology_) throw InternalError("Checker::check called before set_triangles");
   if (static_cast<int64_t>(positions.size()) != topology_->vertex_count)
     throw InternalError("frame has " + std::to_string(positions.size()) +
@@ -71,6 +72,7 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   if (topology_->triangle_count() == 0) return result;
   const ExactContext context{positions, topology_.get()};
   backend_->set_positions(positions);
+  if (!next_positions.empty()) backend_->stage_positions(next_positions);
 
   // Zero-area triangles first: they are left out of the search and own no edges. Mode `all`
   // decides every triangle exactly.
@@ -119,8 +121,8 @@ FrameResult Checker::check(std::span<const geom::Vec3d> positions) {
   }
   result.tree_quality = backend_->tree_quality();
 
-  FilteredFrame frame = backend_->detect(
-      result.degenerate, exact_all ? FilterUse::defer_all : FilterUse::certify);
+  FilteredFrame frame =
+      backend_->detect(result.degenerate, exact_all ? FilterUse::defer_all : FilterUse::certify);
   result.times.traverse = frame.traverse_seconds;
   result.times.classify = frame.classify_seconds;
   result.candidate_pairs = frame.candidate_pairs;

@@ -42,6 +42,11 @@ class Backend {
   virtual void set_topology(const Topology& topology) = 0;
   /// This frame's positions (vertex_count entries); valid until the next call.
   virtual void set_positions(std::span<const geom::Vec3d> positions) = 0;
+  /// The next frame's positions, given while the current one is checked, so that a backend
+  /// with memory of its own can copy them across meanwhile; a set_positions() with the same
+  /// span (same address and size, contents unchanged since) then copies nothing. A hint: the
+  /// CPU backend has nothing to copy, and a span never set is dropped.
+  virtual void stage_positions(std::span<const geom::Vec3d> next) { (void)next; }
   virtual DegeneracyScan scan_degenerate() = 0;
   /// Builds the tree over the current positions.
   virtual void build() = 0;

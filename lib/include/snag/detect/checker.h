@@ -41,7 +41,12 @@ class Checker {
 
   /// Checks one frame. `positions` has vertex_count entries and must stay valid during the call.
   /// Throws snag::InputError when a coordinate is NaN or infinite.
-  FrameResult check(std::span<const geom::Vec3d> positions);
+  ///
+  /// `next_positions`, when given, are the frame the next check() will be given: a GPU backend
+  /// copies them across while this frame is checked. They must stay valid and unchanged until
+  /// that check() returns (a different next frame is merely copied again).
+  FrameResult check(std::span<const geom::Vec3d> positions,
+                    std::span<const geom::Vec3d> next_positions = {});
 
   int rebuild_count() const { return rebuilds_; }  ///< builds other than the first of each topology
   int build_count() const { return builds_; }
