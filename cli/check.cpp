@@ -20,6 +20,7 @@
 #include "snag/io/read_mesh.h"
 #include "snag/mesh/weld.h"
 #include "snag/report/report.h"
+#include "snag/report/stream.h"
 #include "snag/report/write.h"
 #include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
@@ -79,15 +80,21 @@ std::string plural(int64_t n, const std::string& word) {
   return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
 }
 
-void print_summary(std::ostream& out, const report::Report& r, const report::Summary& s,
-                   const std::string& out_dir) {
+/// What the summary prints besides the frames' counts: known only at the end of the run.
+struct RunTotals {
+  int builds = 0;
+  int rebuilds = 0;
+  double wall_seconds = 0;
+};
+
+void print_summary(std::ostream& out, const report::Summary& s, const RunTotals& totals,
+                   const std::string& rebuild_policy, const std::string& out_dir) {
   out << "frames checked       " << s.frames_checked << "\n";
   out << "frames with crossing " << s.frames_with_crossings << "\n";
   out << "worst frame          ";
-  if (s.worst_frame) {
-    const report::FrameRecord& w = r.frames[*s.worst_frame];
-    out << w.frame << " (" << w.file << "): " << w.crossing_count() << " crossing, "
-        << w.touching_count() << " touching\n";
+  if (s.worst) {
+    out << s.worst->frame << " (" << s.worst->file << "): " << s.worst->crossing << " crossing, "
+        << s.worst->touching() << " touching\n";
   } else {
     out << "none\n";
   }
@@ -97,9 +104,9 @@ void print_summary(std::ostream& out, const report::Report& r, const report::Sum
   const double per_frame = s.frames_checked > 0 ? s.check_seconds / s.frames_checked : 0.0;
   out << "time                 " << fixed(s.check_seconds, 3) << " s checking ("
       << fixed(per_frame * 1e3, 2) << " ms per frame), " << fixed(s.read_seconds, 3)
-      << " s reading, " << fixed(r.wall_seconds, 3) << " s in all\n";
-  out << "tree                 " << plural(r.builds, "build") << ", "
-      << plural(r.rebuilds, "rebuild") << " (--rebuild " << r.settings.rebuild << "), "
+      << " s reading, " << fixed(totals.wall_seconds, 3) << " s in all\n";
+  out << "tree                 " << plural(totals.builds, "build") << ", "
+      << plural(totals.rebuilds, "rebuild") << " (--rebuild " << rebuild_policy << "), "
       << plural(s.topology_changes, "topology change") << "\n";
   if (!out_dir.empty())
     out << "reports              " << (std::filesystem::path(out_dir) / "").string()
@@ -193,20 +200,26 @@ int run_check(const CheckOptions& o) {
   const std::unique_ptr<detect::Checker> checker =
       validators::make_checker(std::move(backend), settings);
 
-  report::Report rep;
-  rep.snag_version = SNAG_VERSION;
-  rep.settings.backend = backend_name;
-  rep.settings.backend_requested = o.backend;
-  rep.settings.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-  rep.settings.exact = std::string(detect::to_string(*exact));
-  rep.settings.exact_predicates = *exact == detect::ExactMode::off ? "rounded" : "cgal";
-  rep.settings.weld = o.weld;
-  rep.settings.rebuild = o.rebuild;
-  rep.settings.rebuild_threshold = o.rebuild_threshold;
-  rep.settings.fail_on = *fail_on;
-  if (!o.frames.empty()) rep.settings.frames = o.frames;
-  rep.inputs.sequence = o.sequence;
-  rep.frames.reserve(frames.size());
+  report::Settings report_settings;
+  report_settings.backend = backend_name;
+  report_settings.backend_requested = o.backend;
+  report_settings.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  report_settings.exact = std::string(detect::to_string(*exact));
+  report_settings.exact_predicates = *exact == detect::ExactMode::off ? "rounded" : "cgal";
+  report_settings.weld = o.weld;
+  report_settings.rebuild = o.rebuild;
+  report_settings.rebuild_threshold = o.rebuild_threshold;
+  report_settings.fail_on = *fail_on;
+  if (!o.frames.empty()) report_settings.frames = o.frames;
+  report::Inputs inputs;
+  inputs.sequence = o.sequence;
+  // Each frame's record is written to the reports' temporaries as soon as it is checked and
+  // dropped: a run holds one frame's pairs, never the sequence's. The reports appear only when
+  // finish() renames them into place; an exception before that (a bad frame 7) unwinds the
+  // stream, which removes its temporaries.
+  std::optional<std::filesystem::path> report_dir;
+  if (!o.out_dir.empty()) report_dir = o.out_dir;
+  report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings));
 
   Progress progress(static_cast<int64_t>(frames.size()), o.quiet);
   std::vector<geom::Tri> file_triangles;  // the current topology, as the file lists it
@@ -251,10 +264,10 @@ int run_check(const CheckOptions& o) {
         int64_t welded = 0;
         for (size_t v = 0; v < representative.size(); ++v)
           welded += representative[v] != static_cast<int32_t>(v);
-        if (i == 0) rep.inputs.welded_vertices = welded;
+        if (i == 0) inputs.welded_vertices = welded;
       } else if (i == 0) {
         const int64_t coincident = mesh::count_coincident_vertices(mesh.positions);
-        rep.inputs.coincident_vertices = coincident;
+        inputs.coincident_vertices = coincident;
         if (coincident > 0 && !o.quiet)
           progress.message("snag: warning: " + file + ": " + std::to_string(coincident) +
                            (coincident == 1 ? " vertex coincides" : " vertices coincide") +
@@ -272,20 +285,20 @@ int run_check(const CheckOptions& o) {
     record.topology_changed = topology_changed;
     record.read_seconds = read_seconds;
     progress.update(static_cast<int64_t>(i) + 1, frame_note(record));
-    rep.frames.push_back(std::move(record));
+    reports.add(record);
   }
   progress.finish();
 
-  rep.inputs.ids = any_assimp ? "assimp" : "file";
-  rep.builds = checker->build_count();
-  rep.rebuilds = checker->rebuild_count();
-  rep.wall_seconds = seconds_since(started);
-  const report::Summary summary = report::summarize(rep);
+  inputs.ids = any_assimp ? "assimp" : "file";
+  RunTotals totals;
+  totals.builds = checker->build_count();
+  totals.rebuilds = checker->rebuild_count();
+  totals.wall_seconds = seconds_since(started);
+  // Only now, with every frame read, checked and written, do the report files appear.
+  const report::Summary summary =
+      reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
 
-  // Only now, with every frame read and checked, do report files appear.
-  if (!o.out_dir.empty()) report::write_reports(o.out_dir, rep);
-
-  print_summary(std::cout, rep, summary, o.out_dir);
+  print_summary(std::cout, summary, totals, o.rebuild, o.out_dir);
   std::cout.flush();
   if (summary.failed && !o.quiet)
     std::cerr << "snag: intersections found (--fail-on " << o.fail_on << "): exit status 1\n";

@@ -243,6 +243,29 @@ TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {
     EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
 }
 
+TEST(CliStatus, BadFrameInTheMiddleKeepsTheEarlierReports) {
+  TempDir tmp;
+  const fs::path seq = write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult first = run_snag({"check", "seq", "--out", "out"}, tmp.path());
+  ASSERT_EQ(first.status, 1) << context(first);
+  const std::vector<std::string> reports = {"frames.csv", "pairs.csv", "report.json"};
+  ASSERT_EQ(directory_entries(tmp.path() / "out"), reports);
+  std::vector<std::string> earlier;
+  for (const std::string& name : reports) earlier.push_back(read_text(tmp.path() / "out" / name));
+
+  // Frame 2 of 4 is malformed: frame 1 was already written to the reports' temporaries when
+  // it is found, and frames 3 and 4 are read ahead of it.
+  write_text(seq / "f.0002.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n");
+  write_text(seq / "f.0004.obj", read_text(seq / "f.0003.obj"));
+  const RunResult r = run_snag({"check", "seq", "--out", "out"}, tmp.path());
+  EXPECT_EQ(r.status, 3) << context(r);
+  EXPECT_NE(r.err.find("f.0002.obj:3"), std::string::npos) << r.err;
+  // No temporary left (the listing shows hidden files) and the earlier run's bytes unchanged.
+  EXPECT_EQ(directory_entries(tmp.path() / "out"), reports);
+  for (size_t i = 0; i < reports.size(); ++i)
+    EXPECT_EQ(read_text(tmp.path() / "out" / reports[i]), earlier[i]) << reports[i];
+}
+
 TEST(CliStatus, VertexCountChangeExitsThree) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");

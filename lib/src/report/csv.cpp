@@ -34,43 +34,54 @@ std::string csv_field(std::string_view field) {
   return quoted;
 }
 
-void write_pairs_csv(std::ostream& out, const Report& report) {
-  out << pairs_csv_header << '\n';
+void write_pairs_rows(std::ostream& out, const FrameRecord& f) {
   // snprintf into a line buffer: a 100K-pair frame is written in milliseconds, and the bytes
   // do not depend on the stream's locale or flags.
   char line[128];
-  std::vector<const Pair*> sorted;
-  for (size_t i : frame_order(report)) {
-    const FrameRecord& f = report.frames[i];
-    sorted.clear();
-    for (const Pair& p : f.pairs) sorted.push_back(&p);
-    std::sort(sorted.begin(), sorted.end(), [](const Pair* x, const Pair* y) {
-      return x->a != y->a ? x->a < y->a : x->b < y->b;
-    });
-    for (const Pair* p : sorted) {
-      const int n = std::snprintf(
-          line, sizeof line, "%" PRId64 ",%d,%d,%s,%d,%d\n", f.frame, p->a, p->b,
-          p->kind == detect::PairKind::crossing ? "crossing" : "touching", p->poly_a, p->poly_b);
-      out.write(line, n);
-    }
+  const auto write_row = [&](const Pair& p) {
+    const int n = std::snprintf(line, sizeof line, "%" PRId64 ",%d,%d,%s,%d,%d\n", f.frame, p.a,
+                                p.b, p.kind == detect::PairKind::crossing ? "crossing" : "touching",
+                                p.poly_a, p.poly_b);
+    out.write(line, n);
+  };
+  const auto by_faces = [](const Pair& x, const Pair& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  };
+  // Records are sorted by construction (make_frame_record); only a record built otherwise
+  // pays for a sorted copy of pointers, one frame's worth.
+  if (std::is_sorted(f.pairs.begin(), f.pairs.end(), by_faces)) {
+    for (const Pair& p : f.pairs) write_row(p);
+    return;
   }
+  std::vector<const Pair*> sorted;
+  sorted.reserve(f.pairs.size());
+  for (const Pair& p : f.pairs) sorted.push_back(&p);
+  std::sort(sorted.begin(), sorted.end(),
+            [&](const Pair* x, const Pair* y) { return by_faces(*x, *y); });
+  for (const Pair* p : sorted) write_row(*p);
+}
+
+void write_frames_row(std::ostream& out, const FrameRecord& f) {
+  char numbers[256];
+  const int64_t crossing = f.crossing_count();
+  const int64_t pairs = static_cast<int64_t>(f.pairs.size());
+  out << f.frame << ',' << csv_field(f.file) << ',';
+  const int n = std::snprintf(numbers, sizeof numbers,
+                              "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d\n",
+                              f.triangles, pairs, crossing, pairs - crossing, f.degenerate.size(),
+                              f.uncertain_tests, f.times.total(), f.rebuilt ? 1 : 0,
+                              f.topology_changed ? 1 : 0);
+  out.write(numbers, n);
+}
+
+void write_pairs_csv(std::ostream& out, const Report& report) {
+  out << pairs_csv_header << '\n';
+  for (size_t i : frame_order(report)) write_pairs_rows(out, report.frames[i]);
 }
 
 void write_frames_csv(std::ostream& out, const Report& report) {
   out << frames_csv_header << '\n';
-  char numbers[256];
-  for (size_t i : frame_order(report)) {
-    const FrameRecord& f = report.frames[i];
-    const int64_t crossing = f.crossing_count();
-    const int64_t pairs = static_cast<int64_t>(f.pairs.size());
-    out << f.frame << ',' << csv_field(f.file) << ',';
-    const int n = std::snprintf(
-        numbers, sizeof numbers,
-        "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d\n", f.triangles, pairs,
-        crossing, pairs - crossing, f.degenerate.size(), f.uncertain_tests, f.times.total(),
-        f.rebuilt ? 1 : 0, f.topology_changed ? 1 : 0);
-    out.write(numbers, n);
-  }
+  for (size_t i : frame_order(report)) write_frames_row(out, report.frames[i]);
 }
 
 }  // namespace snag::report

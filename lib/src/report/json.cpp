@@ -1,6 +1,10 @@
 #include "snag/report/json.h"
 
+#include <sstream>
+
 #include <nlohmann/json.hpp>
+
+#include "json_layout.h"
 
 namespace snag::report {
 
@@ -48,66 +52,139 @@ ordered_json frame_json(const FrameRecord& f) {
   return j;
 }
 
-}  // namespace
+// Indentation levels of the two arrays that grow with the run: "files" is a member of
+// "inputs", a member of the root; "frames" is a member of the root.
+constexpr int files_level = 2;
+constexpr int frames_level = 1;
 
-std::string report_json(const Report& report) {
-  const Summary s = summarize(report);
-  ordered_json j;
-  j["schema"] = std::string(json_schema);
-  j["snag"] = {{"version", report.snag_version}};
+std::string indent(int level) {
+  return std::string(2 * level, ' ');
+}
 
-  const Settings& set = report.settings;
-  j["settings"] = {{"backend", set.backend},
-                   {"backend_requested", set.backend_requested},
-                   {"threads", set.threads},
-                   {"exact", set.exact},
-                   {"exact_predicates", set.exact_predicates},
-                   {"weld", set.weld ? ordered_json(*set.weld) : ordered_json(nullptr)},
-                   {"rebuild", set.rebuild},
-                   {"rebuild_threshold", set.rebuild_threshold},
-                   {"fail_on", std::string(to_string(set.fail_on))},
-                   {"frames", set.frames ? ordered_json(*set.frames) : ordered_json(nullptr)}};
-
-  ordered_json files = ordered_json::array();
-  for (const FrameRecord& f : report.frames) files.push_back(f.file);
-  j["inputs"] = {{"sequence", report.inputs.sequence},
-                 {"ids", report.inputs.ids},
-                 {"files", std::move(files)},
-                 {"coincident_vertices", report.inputs.coincident_vertices},
-                 {"welded_vertices", report.inputs.welded_vertices}};
-
-  ordered_json frames = ordered_json::array();
-  for (const FrameRecord& f : report.frames) frames.push_back(frame_json(f));
-  j["frames"] = std::move(frames);
-
-  ordered_json worst = nullptr;
-  if (s.worst_frame) {
-    const FrameRecord& w = report.frames[*s.worst_frame];
-    worst = {{"frame", w.frame},
-             {"file", w.file},
-             {"crossing", w.crossing_count()},
-             {"pairs", w.pairs.size()}};
-  }
-  j["summary"] = {
-      {"frames_checked", s.frames_checked},
-      {"frames_with_crossings", s.frames_with_crossings},
-      {"frames_with_pairs", s.frames_with_pairs},
-      {"worst_frame", std::move(worst)},
-      {"pairs", s.pairs},
-      {"crossing", s.crossing},
-      {"touching", s.touching},
-      {"degenerate", s.degenerate},
-      {"uncertain_tests", s.uncertain_tests},
-      {"confirmed_pairs", s.confirmed_pairs},
-      {"topology_changes", s.topology_changes},
-      {"builds", report.builds},
-      {"rebuilds", report.rebuilds},
-      {"seconds",
-       {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", report.wall_seconds}}},
-      {"failed", s.failed}};
+/// `value` as dump(2) lays it out when it starts on a line indented `level` times: every line
+/// after the first indented by 2 * level more spaces. A line break inside a string is
+/// escaped by the dump, so every "\n" in it is one the layout put there.
+std::string dump_at(const ordered_json& value, int level) {
   // Invalid UTF-8 in a file name is replaced rather than thrown: the report must still be
   // written for a path the filesystem accepted.
-  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string text = value.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+  const std::string margin = indent(level);
+  std::string laid_out;
+  laid_out.reserve(text.size() + text.size() / 8);
+  for (char c : text) {
+    laid_out += c;
+    if (c == '\n') laid_out += margin;
+  }
+  return laid_out;
+}
+
+/// `"key": value` on a line indented `level` times, without the line's end. `key` is one of
+/// the schema's plain names: nothing in it needs escaping.
+std::string member(std::string_view key, const ordered_json& value, int level) {
+  return indent(level) + '"' + std::string(key) + "\": " + dump_at(value, level);
+}
+
+/// An element of an array whose opening line is indented `array_level` times.
+std::string array_element(const ordered_json& value, int array_level, bool first) {
+  return (first ? "\n" : ",\n") + indent(array_level + 1) + dump_at(value, array_level + 1);
+}
+
+/// An array whose elements `write_elements` writes (array_element's text), "[]" when empty.
+void write_array(std::ostream& out, int level, bool empty,
+                 const std::function<void(std::ostream&)>& write_elements) {
+  out << '[';
+  write_elements(out);
+  if (!empty) out << '\n' << indent(level);
+  out << ']';
+}
+
+ordered_json summary_json(const Report& run, const Summary& s) {
+  ordered_json worst = nullptr;
+  if (s.worst)
+    worst = {{"frame", s.worst->frame},
+             {"file", s.worst->file},
+             {"crossing", s.worst->crossing},
+             {"pairs", s.worst->pairs}};
+  return {{"frames_checked", s.frames_checked},
+          {"frames_with_crossings", s.frames_with_crossings},
+          {"frames_with_pairs", s.frames_with_pairs},
+          {"worst_frame", std::move(worst)},
+          {"pairs", s.pairs},
+          {"crossing", s.crossing},
+          {"touching", s.touching},
+          {"degenerate", s.degenerate},
+          {"uncertain_tests", s.uncertain_tests},
+          {"confirmed_pairs", s.confirmed_pairs},
+          {"topology_changes", s.topology_changes},
+          {"builds", run.builds},
+          {"rebuilds", run.rebuilds},
+          {"seconds",
+           {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", run.wall_seconds}}},
+          {"failed", s.failed}};
+}
+
+}  // namespace
+
+std::string json_file_element(const std::string& file, bool first) {
+  return array_element(ordered_json(file), files_level, first);
+}
+
+std::string json_frame_element(const FrameRecord& frame, bool first) {
+  return array_element(frame_json(frame), frames_level, first);
+}
+
+void write_report_json(std::ostream& out, const Report& run, const Summary& summary,
+                       const std::function<void(std::ostream&)>& write_files,
+                       const std::function<void(std::ostream&)>& write_frames) {
+  const Settings& set = run.settings;
+  const ordered_json settings = {
+      {"backend", set.backend},
+      {"backend_requested", set.backend_requested},
+      {"threads", set.threads},
+      {"exact", set.exact},
+      {"exact_predicates", set.exact_predicates},
+      {"weld", set.weld ? ordered_json(*set.weld) : ordered_json(nullptr)},
+      {"rebuild", set.rebuild},
+      {"rebuild_threshold", set.rebuild_threshold},
+      {"fail_on", std::string(to_string(set.fail_on))},
+      {"frames", set.frames ? ordered_json(*set.frames) : ordered_json(nullptr)}};
+  const bool no_frames = summary.frames_checked == 0;
+
+  // The root object (level 0) with its members at level 1; inputs is spelled out member by
+  // member because its files array is written by the caller.
+  out << "{\n";
+  out << member("schema", std::string(json_schema), 1) << ",\n";
+  out << member("snag", {{"version", run.snag_version}}, 1) << ",\n";
+  out << member("settings", settings, 1) << ",\n";
+  out << indent(1) << "\"inputs\": {\n";
+  out << member("sequence", run.inputs.sequence, 2) << ",\n";
+  out << member("ids", run.inputs.ids, 2) << ",\n";
+  out << indent(files_level) << "\"files\": ";
+  write_array(out, files_level, no_frames, write_files);
+  out << ",\n";
+  out << member("coincident_vertices", run.inputs.coincident_vertices, 2) << ",\n";
+  out << member("welded_vertices", run.inputs.welded_vertices, 2) << "\n";
+  out << indent(1) << "},\n";
+  out << indent(frames_level) << "\"frames\": ";
+  write_array(out, frames_level, no_frames, write_frames);
+  out << ",\n";
+  out << member("summary", summary_json(run, summary), 1) << "\n";
+  out << "}\n";
+}
+
+std::string report_json(const Report& report) {
+  std::ostringstream out;
+  write_report_json(
+      out, report, summarize(report),
+      [&](std::ostream& files) {
+        for (size_t i = 0; i < report.frames.size(); ++i)
+          files << json_file_element(report.frames[i].file, i == 0);
+      },
+      [&](std::ostream& frames) {
+        for (size_t i = 0; i < report.frames.size(); ++i)
+          frames << json_frame_element(report.frames[i], i == 0);
+      });
+  return out.str();
 }
 
 }  // namespace snag::report

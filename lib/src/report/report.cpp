@@ -70,34 +70,32 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
   return record;
 }
 
-Summary summarize(const Report& report) {
-  Summary s;
-  s.frames_checked = static_cast<int64_t>(report.frames.size());
-  int64_t worst_crossing = -1;
-  int64_t worst_pairs = -1;
-  for (size_t i = 0; i < report.frames.size(); ++i) {
-    const FrameRecord& f = report.frames[i];
-    const int64_t crossing = f.crossing_count();
-    const int64_t pairs = static_cast<int64_t>(f.pairs.size());
-    s.frames_with_crossings += crossing > 0;
-    s.frames_with_pairs += pairs > 0;
-    s.pairs += pairs;
-    s.crossing += crossing;
-    s.touching += pairs - crossing;
-    s.degenerate += static_cast<int64_t>(f.degenerate.size());
-    s.uncertain_tests += f.uncertain_tests;
-    s.confirmed_pairs += f.confirmed_pairs;
-    s.topology_changes += f.topology_changed;
-    s.check_seconds += f.times.total();
-    s.read_seconds += f.read_seconds;
-    if (pairs > 0 &&
-        (crossing > worst_crossing || (crossing == worst_crossing && pairs > worst_pairs))) {
-      s.worst_frame = i;
-      worst_crossing = crossing;
-      worst_pairs = pairs;
-    }
+void SummaryAccumulator::add(const FrameRecord& frame) {
+  Summary& s = summary_;
+  const int64_t crossing = frame.crossing_count();
+  const int64_t pairs = static_cast<int64_t>(frame.pairs.size());
+  const size_t position = static_cast<size_t>(s.frames_checked);
+  s.frames_checked += 1;
+  s.frames_with_crossings += crossing > 0;
+  s.frames_with_pairs += pairs > 0;
+  s.pairs += pairs;
+  s.crossing += crossing;
+  s.touching += pairs - crossing;
+  s.degenerate += static_cast<int64_t>(frame.degenerate.size());
+  s.uncertain_tests += frame.uncertain_tests;
+  s.confirmed_pairs += frame.confirmed_pairs;
+  s.topology_changes += frame.topology_changed;
+  s.check_seconds += frame.times.total();
+  s.read_seconds += frame.read_seconds;
+  // Strictly more crossing, or as many and strictly more pairs: on a full tie the earlier
+  // frame stays the worst.
+  const bool worse = pairs > 0 && (!s.worst || crossing > s.worst->crossing ||
+                                   (crossing == s.worst->crossing && pairs > s.worst->pairs));
+  if (worse) {
+    s.worst_frame = position;
+    s.worst = WorstFrame{frame.frame, frame.file, crossing, pairs};
   }
-  switch (report.settings.fail_on) {
+  switch (fail_on_) {
     case FailOn::crossing:
       s.failed = s.crossing > 0;
       break;
@@ -108,7 +106,12 @@ Summary summarize(const Report& report) {
       s.failed = false;
       break;
   }
-  return s;
+}
+
+Summary summarize(const Report& report) {
+  SummaryAccumulator accumulator(report.settings.fail_on);
+  for (const FrameRecord& frame : report.frames) accumulator.add(frame);
+  return accumulator.summary();
 }
 
 }  // namespace snag::report

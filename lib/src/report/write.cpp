@@ -1,44 +1,17 @@
 #include "snag/report/write.h"
 
-#include <unistd.h>
-
-#include <atomic>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <system_error>
+#include <numeric>
 
-#include "snag/report/csv.h"
-#include "snag/report/json.h"
+#include "snag/report/stream.h"
+#include "staged_files.h"
 
 namespace snag::report {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-/// A hidden name in the same directory (rename is atomic only within one filesystem), unique
-/// per process and call so two runs writing into one directory never share a temporary.
-fs::path temporary_name(const fs::path& dir, const std::string& name) {
-  static std::atomic<unsigned> counter{0};
-  return dir / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
-                std::to_string(counter.fetch_add(1)));
-}
-
-void remove_quietly(const fs::path& path) {
-  std::error_code ignored;
-  fs::remove(path, ignored);
-}
-
-void ensure_directory(const fs::path& dir) {
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw WriteError(dir, "exists and is not a directory");
-  fs::create_directories(dir, ec);
-  if (ec) throw WriteError(dir, "cannot create the output directory: " + ec.message());
-}
-
-}  // namespace
 
 void prepare_output_dir(const fs::path& dir) {
   ensure_directory(dir);
@@ -53,36 +26,26 @@ void prepare_output_dir(const fs::path& dir) {
 }
 
 void write_files_atomically(const fs::path& dir, const std::vector<OutputFile>& files) {
-  ensure_directory(dir);
-  std::vector<fs::path> temporaries;
-  try {
-    for (const OutputFile& file : files) {
-      const fs::path tmp = temporary_name(dir, file.name);
-      temporaries.push_back(tmp);
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out)
-        throw WriteError(dir / file.name, std::string("cannot create: ") + std::strerror(errno));
-      file.write(out);
-      out.close();
-      // close() flushes; a full disk shows up here, not at the first write.
-      if (!out) throw WriteError(dir / file.name, "write failed (disk full?)");
-    }
-    for (size_t i = 0; i < files.size(); ++i) {
-      std::error_code ec;
-      fs::rename(temporaries[i], dir / files[i].name, ec);
-      if (ec) throw WriteError(dir / files[i].name, "cannot rename into place: " + ec.message());
-    }
-  } catch (...) {
-    for (const fs::path& tmp : temporaries) remove_quietly(tmp);
-    throw;
+  StagedFiles staged(dir);
+  for (const OutputFile& file : files) {
+    StagedFile& staged_file = staged.create(file.name);
+    file.write(staged_file.out());
+    staged_file.close();
   }
+  staged.commit();
 }
 
 void write_reports(const fs::path& dir, const Report& report) {
-  write_files_atomically(dir,
-                         {{"pairs.csv", [&](std::ostream& out) { write_pairs_csv(out, report); }},
-                          {"frames.csv", [&](std::ostream& out) { write_frames_csv(out, report); }},
-                          {"report.json", [&](std::ostream& out) { out << report_json(report); }}});
+  // The stream takes frames in frame order; Report::frames is documented in that order, and a
+  // report recorded otherwise is written sorted (stably), as write_pairs_csv sorts its rows.
+  std::vector<size_t> order(report.frames.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+    return report.frames[x].frame < report.frames[y].frame;
+  });
+  ReportStream stream(dir, report.snag_version, report.settings);
+  for (size_t i : order) stream.add(report.frames[i]);
+  stream.finish(report.inputs, report.builds, report.rebuilds, report.wall_seconds);
 }
 
 }  // namespace snag::report

@@ -23,8 +23,17 @@ inline constexpr std::string_view frames_csv_header =
     "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
     "topology_changed";
 
+/// The whole files for a report in memory: the header, then every frame's rows in increasing
+/// frame number (stable, so frames recorded out of order still give sorted files).
 void write_pairs_csv(std::ostream& out, const Report& report);
 void write_frames_csv(std::ostream& out, const Report& report);
+
+/// One frame's rows of pairs.csv, its pairs sorted by (a, b) whatever their order in the
+/// record; nothing for a clean frame. The only formatter of these rows (ReportStream and
+/// write_pairs_csv both use it).
+void write_pairs_rows(std::ostream& out, const FrameRecord& frame);
+/// One frame's row of frames.csv; the only formatter of that row.
+void write_frames_row(std::ostream& out, const FrameRecord& frame);
 
 /// `field` as one CSV field: unchanged unless it holds a comma, quote, CR or LF.
 std::string csv_field(std::string_view field);

@@ -26,7 +26,8 @@ namespace snag::report {
 
 inline constexpr std::string_view json_schema = "snag-report/2";
 
-/// The report as JSON text (two-space indentation, a trailing newline).
+/// The report as JSON text (two-space indentation, a trailing newline), frames in the order of
+/// report.frames. ReportStream writes the same bytes piece by piece.
 std::string report_json(const Report& report);
 
 }  // namespace snag::report

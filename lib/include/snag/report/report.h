@@ -1,6 +1,7 @@
 // What `snag check` reports: the settings and inputs of a run, one record per checked frame
 // with its pairs in the ids users see, and a summary. Writers (csv.h, json.h, write.h) turn a
-// Report into files; nothing here depends on how the frames were checked.
+// Report into files, and stream.h writes the same files frame by frame without keeping the
+// frames; nothing here depends on how the frames were checked.
 #pragma once
 
 #include <cstdint>
@@ -99,16 +100,29 @@ struct Report {
   std::vector<FrameRecord> frames;  ///< in checking order (increasing frame number)
   int builds = 0;                   ///< tree builds, the first of each topology included
   int rebuilds = 0;                 ///< builds beyond the first of each topology
-  double wall_seconds = 0;          ///< the whole run: reading, checking and accumulating
+  double wall_seconds = 0;          ///< the run up to its last frame: reading, checking, rows
+};
+
+/// The worst frame's identity and counts, kept by the summary so that nobody needs the frame.
+struct WorstFrame {
+  int64_t frame = 0;
+  std::string file;
+  int64_t crossing = 0;
+  int64_t pairs = 0;
+  int64_t touching() const { return pairs - crossing; }
+  friend bool operator==(const WorstFrame&, const WorstFrame&) = default;
 };
 
 struct Summary {
   int64_t frames_checked = 0;
   int64_t frames_with_crossings = 0;
   int64_t frames_with_pairs = 0;
-  /// Index into Report::frames of the frame with the most crossing pairs (ties: most pairs,
-  /// then the earliest); nullopt when no frame has a pair.
+  /// Position, in the order the frames were added (for summarize: the index into
+  /// Report::frames), of the frame with the most crossing pairs (ties: most pairs, then the
+  /// earliest); nullopt when no frame has a pair.
   std::optional<size_t> worst_frame;
+  /// That frame's number, file and counts; set exactly when worst_frame is.
+  std::optional<WorstFrame> worst;
   int64_t pairs = 0;
   int64_t crossing = 0;
   int64_t touching = 0;
@@ -116,11 +130,27 @@ struct Summary {
   int64_t uncertain_tests = 0;
   int64_t confirmed_pairs = 0;
   int64_t topology_changes = 0;
-  double check_seconds = 0;  ///< sum of the frames' checking times
+  double check_seconds = 0;  ///< sum of the frames' checking times, in the order added
   double read_seconds = 0;
   bool failed = false;  ///< the run fails under settings.fail_on
+  friend bool operator==(const Summary&, const Summary&) = default;
 };
 
+/// A run's summary built frame by frame: it holds the counts and the worst frame's number,
+/// file and counts, never a frame, so its memory does not grow with the run. summary() is
+/// up to date after every add().
+class SummaryAccumulator {
+ public:
+  explicit SummaryAccumulator(FailOn fail_on) : fail_on_(fail_on) {}
+  void add(const FrameRecord& frame);
+  const Summary& summary() const { return summary_; }
+
+ private:
+  FailOn fail_on_;
+  Summary summary_;
+};
+
+/// The summary of report.frames in their order: a SummaryAccumulator fed every frame.
 Summary summarize(const Report& report);
 
 }  // namespace snag::report

@@ -1,6 +1,7 @@
 // Writing the report files of `--out DIR`, each complete or not at all: every file is written
-// to a temporary name in DIR and renamed over its final name only when all of them were
+// to a hidden temporary name in DIR and renamed over its final name only when all of them were
 // written, so a failure leaves no new file behind (and an earlier run's files untouched).
+// ReportStream (stream.h) writes the reports of a run frame by frame with the same mechanism.
 #pragma once
 
 #include <filesystem>
@@ -40,7 +41,10 @@ void write_files_atomically(const std::filesystem::path& dir, const std::vector<
 /// does not fail at its end); creates it. Throws WriteError otherwise.
 void prepare_output_dir(const std::filesystem::path& dir);
 
-/// Writes pairs.csv, frames.csv and report.json into `dir`, all complete or none.
+/// Writes pairs.csv, frames.csv and report.json into `dir`, all complete or none, through a
+/// ReportStream fed report.frames in increasing frame number (stable: the documented order of
+/// Report::frames; a report recorded out of order gets its report.json frames sorted too,
+/// unlike report_json, which keeps the record order).
 void write_reports(const std::filesystem::path& dir, const Report& report);
 
 }  // namespace snag::report

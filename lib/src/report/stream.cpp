@@ -1,0 +1,118 @@
+#include "snag/report/stream.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <vector>
+
+#include "json_layout.h"
+#include "snag/error.h"
+#include "snag/report/csv.h"
+#include "snag/report/write.h"
+#include "staged_files.h"
+
+namespace snag::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Appends the scratch file `piece` to `out` in fixed-size chunks: a spool holds the whole
+/// run's records and is never read into memory at once.
+void append_scratch(const StagedFile& piece, std::ostream& out) {
+  std::ifstream in(piece.temporary_path(), std::ios::binary);
+  if (!in)
+    throw WriteError(piece.final_path(), std::string("cannot read back its temporary ") +
+                                             piece.temporary_path().filename().string() + ": " +
+                                             std::strerror(errno));
+  std::vector<char> chunk(1 << 16);
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0)
+    out.write(chunk.data(), in.gcount());
+  if (in.bad())
+    throw WriteError(piece.final_path(),
+                     "read failed on its temporary " + piece.temporary_path().filename().string());
+}
+
+}  // namespace
+
+/// The three reports' temporaries and report.json's two spools. The reports are created first,
+/// in the order write_reports has always renamed them.
+struct ReportStream::Files {
+  explicit Files(const fs::path& dir)
+      : staged(dir),
+        pairs_csv(staged.create("pairs.csv")),
+        frames_csv(staged.create("frames.csv")),
+        report_json(staged.create("report.json")),
+        file_names(staged.create_scratch("report.json", "files")),
+        frame_records(staged.create_scratch("report.json", "frames")) {}
+
+  StagedFiles staged;
+  StagedFile& pairs_csv;
+  StagedFile& frames_csv;
+  StagedFile& report_json;    ///< written by finish() only
+  StagedFile& file_names;     ///< inputs.files elements, one per frame added
+  StagedFile& frame_records;  ///< frames elements, one per frame added
+};
+
+ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings)
+    : accumulator_(settings.fail_on) {
+  run_.snag_version = std::move(snag_version);
+  run_.settings = std::move(settings);
+  if (!dir) return;
+  files_ = std::make_unique<Files>(*dir);
+  files_->pairs_csv.out() << pairs_csv_header << '\n';
+  files_->frames_csv.out() << frames_csv_header << '\n';
+}
+
+ReportStream::~ReportStream() = default;  // files_'s StagedFiles removes what was not renamed
+
+const Summary& ReportStream::summary() const {
+  return accumulator_.summary();
+}
+
+void ReportStream::add(const FrameRecord& frame) {
+  if (finished_)
+    throw InternalError("report: frame " + std::to_string(frame.frame) +
+                        " added after the report was finished");
+  if (last_frame_ && frame.frame < *last_frame_)
+    throw InternalError("report: frame " + std::to_string(frame.frame) + " added after frame " +
+                        std::to_string(*last_frame_) +
+                        "; frames must come in increasing frame number");
+  if (files_) {
+    const bool first = accumulator_.summary().frames_checked == 0;
+    write_pairs_rows(files_->pairs_csv.out(), frame);
+    write_frames_row(files_->frames_csv.out(), frame);
+    files_->file_names.out() << json_file_element(frame.file, first);
+    files_->frame_records.out() << json_frame_element(frame, first);
+    // A failed write is reported at the frame it hit, not at the end of the run.
+    for (const StagedFile* f :
+         {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->frame_records})
+      f->check();
+  }
+  accumulator_.add(frame);
+  last_frame_ = frame.frame;
+}
+
+Summary ReportStream::finish(const Inputs& inputs, int builds, int rebuilds, double wall_seconds) {
+  if (finished_) throw InternalError("report: finished twice");
+  finished_ = true;
+  run_.inputs = inputs;
+  run_.builds = builds;
+  run_.rebuilds = rebuilds;
+  run_.wall_seconds = wall_seconds;
+  const Summary summary = accumulator_.summary();
+  if (files_) {
+    // The spools are closed (flushed, checked) before they are read back.
+    files_->file_names.close();
+    files_->frame_records.close();
+    write_report_json(
+        files_->report_json.out(), run_, summary,
+        [&](std::ostream& out) { append_scratch(files_->file_names, out); },
+        [&](std::ostream& out) { append_scratch(files_->frame_records, out); });
+    files_->staged.commit();
+    files_.reset();
+  }
+  return summary;
+}
+
+}  // namespace snag::report

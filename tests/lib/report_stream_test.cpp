@@ -1,0 +1,606 @@
+// The streamed reports: byte for byte the hand-written files of a small run, the same bytes as
+// the whole-report writers on a large random run, nothing left behind by a run that fails, and
+// the summary accumulator against a brute-force recount.
+#include <signal.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "report_files.h"
+#include "snag/error.h"
+#include "snag/report/csv.h"
+#include "snag/report/json.h"
+#include "snag/report/report.h"
+#include "snag/report/stream.h"
+#include "snag/report/write.h"
+
+namespace snag::report {
+namespace {
+
+namespace fs = std::filesystem;
+using detect::PairKind;
+
+Settings small_settings() {
+  Settings s;
+  s.backend = "cpu";
+  s.backend_requested = "auto";
+  s.threads = 2;
+  s.exact = "uncertain";
+  s.exact_predicates = "cgal";
+  s.rebuild = "auto";
+  s.rebuild_threshold = 1.5;
+  s.fail_on = FailOn::any;
+  s.frames = "3-4";
+  return s;
+}
+
+Inputs small_inputs() {
+  Inputs in;
+  in.sequence = "cache/cloth.%04d.obj";
+  return in;
+}
+
+/// Two frames built field by field (not by make_frame_record): frame 3 with a crossing and a
+/// touching pair and a degenerate face, frame 4 clean, with a file name that CSV must quote.
+/// Every time is a sum of powers of two, so the expected decimals are exact.
+std::vector<FrameRecord> small_frames() {
+  FrameRecord f3;
+  f3.frame = 3;
+  f3.file = "cache/cloth.0003.obj";
+  f3.vertices = 6;
+  f3.triangles = 4;
+  f3.polygons = 3;
+  f3.pairs = {{0, 3, PairKind::crossing, 0, 2}, {1, 3, PairKind::touching, 1, 2}};
+  f3.degenerate = {{2, 1}};
+  f3.candidate_pairs = 7;
+  f3.filtered_tests = 12;
+  f3.uncertain_tests = 1;
+  f3.rebuilt = true;
+  f3.tree_quality = 1.5;
+  f3.times.build = 0.5;
+  f3.times.traverse = 0.25;
+  f3.times.classify = 0.125;
+  f3.read_seconds = 0.0625;
+
+  FrameRecord f4;
+  f4.frame = 4;
+  f4.file = "cache/cloth,\"b\".0004.obj";
+  f4.vertices = 6;
+  f4.triangles = 4;
+  f4.polygons = 3;
+  f4.candidate_pairs = 3;
+  f4.filtered_tests = 4;
+  f4.topology_changed = true;
+  f4.tree_quality = 2.0;
+  f4.times.refit = 0.25;
+  f4.times.traverse = 0.25;
+  f4.read_seconds = 0.125;
+  return {f3, f4};
+}
+
+constexpr const char* small_pairs_csv =
+    "frame,face_a,face_b,kind,poly_a,poly_b\n"
+    "3,0,3,crossing,0,2\n"
+    "3,1,3,touching,1,2\n";
+
+constexpr const char* small_frames_csv =
+    "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
+    "topology_changed\n"
+    "3,cache/cloth.0003.obj,4,2,1,1,1,1,0.875000,1,0\n"
+    "4,\"cache/cloth,\"\"b\"\".0004.obj\",4,0,0,0,0,0,0.500000,0,1\n";
+
+constexpr const char* small_report_json = R"json({
+  "schema": "snag-report/2",
+  "snag": {
+    "version": "1.2.3"
+  },
+  "settings": {
+    "backend": "cpu",
+    "backend_requested": "auto",
+    "threads": 2,
+    "exact": "uncertain",
+    "exact_predicates": "cgal",
+    "weld": null,
+    "rebuild": "auto",
+    "rebuild_threshold": 1.5,
+    "fail_on": "any",
+    "frames": "3-4"
+  },
+  "inputs": {
+    "sequence": "cache/cloth.%04d.obj",
+    "ids": "file",
+    "files": [
+      "cache/cloth.0003.obj",
+      "cache/cloth,\"b\".0004.obj"
+    ],
+    "coincident_vertices": 0,
+    "welded_vertices": 0
+  },
+  "frames": [
+    {
+      "frame": 3,
+      "file": "cache/cloth.0003.obj",
+      "vertices": 6,
+      "triangles": 4,
+      "polygons": 3,
+      "topology_changed": false,
+      "rebuilt": true,
+      "tree_quality": 1.5,
+      "counts": {
+        "pairs": 2,
+        "crossing": 1,
+        "touching": 1,
+        "degenerate": 1,
+        "candidate_pairs": 7,
+        "filtered_tests": 12,
+        "uncertain_tests": 1,
+        "confirmed_pairs": 0
+      },
+      "seconds": {
+        "read": 0.0625,
+        "build": 0.5,
+        "refit": 0.0,
+        "traverse": 0.25,
+        "exact": 0.0,
+        "classify": 0.125,
+        "confirm": 0.0,
+        "total": 0.875
+      },
+      "pairs": [
+        {
+          "a": 0,
+          "b": 3,
+          "kind": "crossing",
+          "poly_a": 0,
+          "poly_b": 2
+        },
+        {
+          "a": 1,
+          "b": 3,
+          "kind": "touching",
+          "poly_a": 1,
+          "poly_b": 2
+        }
+      ],
+      "degenerate": [
+        {
+          "face": 2,
+          "poly": 1
+        }
+      ]
+    },
+    {
+      "frame": 4,
+      "file": "cache/cloth,\"b\".0004.obj",
+      "vertices": 6,
+      "triangles": 4,
+      "polygons": 3,
+      "topology_changed": true,
+      "rebuilt": false,
+      "tree_quality": 2.0,
+      "counts": {
+        "pairs": 0,
+        "crossing": 0,
+        "touching": 0,
+        "degenerate": 0,
+        "candidate_pairs": 3,
+        "filtered_tests": 4,
+        "uncertain_tests": 0,
+        "confirmed_pairs": 0
+      },
+      "seconds": {
+        "read": 0.125,
+        "build": 0.0,
+        "refit": 0.25,
+        "traverse": 0.25,
+        "exact": 0.0,
+        "classify": 0.0,
+        "confirm": 0.0,
+        "total": 0.5
+      },
+      "pairs": [],
+      "degenerate": []
+    }
+  ],
+  "summary": {
+    "frames_checked": 2,
+    "frames_with_crossings": 1,
+    "frames_with_pairs": 1,
+    "worst_frame": {
+      "frame": 3,
+      "file": "cache/cloth.0003.obj",
+      "crossing": 1,
+      "pairs": 2
+    },
+    "pairs": 2,
+    "crossing": 1,
+    "touching": 1,
+    "degenerate": 1,
+    "uncertain_tests": 1,
+    "confirmed_pairs": 0,
+    "topology_changes": 1,
+    "builds": 1,
+    "rebuilds": 0,
+    "seconds": {
+      "check": 1.375,
+      "read": 0.1875,
+      "wall": 2.5
+    },
+    "failed": true
+  }
+}
+)json";
+
+/// The same run as one in-memory Report, for the whole-report writers.
+Report whole_report(const std::string& version, const Settings& settings, const Inputs& inputs,
+                    std::vector<FrameRecord> frames, int builds, int rebuilds, double wall) {
+  Report r;
+  r.snag_version = version;
+  r.settings = settings;
+  r.inputs = inputs;
+  r.frames = std::move(frames);
+  r.builds = builds;
+  r.rebuilds = rebuilds;
+  r.wall_seconds = wall;
+  return r;
+}
+
+/// True when `text` is laid out as nlohmann's dump(2) lays out the document it holds: the
+/// layout of the whole-document dump that report.json has always been, checked without the
+/// piecewise writer under test (every number the report holds reads back to itself).
+bool is_whole_document_dump(const std::string& text) {
+  return nlohmann::ordered_json::parse(text).dump(2) + "\n" == text;
+}
+
+TEST(ReportStream, SmallRunGivesTheHandWrittenBytes) {
+  TempDir tmp;
+  const fs::path out = tmp.path() / "out";
+  ReportStream stream(out, "1.2.3", small_settings());
+  for (const FrameRecord& f : small_frames()) stream.add(f);
+  const Summary s = stream.finish(small_inputs(), 1, 0, 2.5);
+
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+  EXPECT_EQ(read_all(out / "pairs.csv"), small_pairs_csv);
+  EXPECT_EQ(read_all(out / "frames.csv"), small_frames_csv);
+  EXPECT_EQ(read_all(out / "report.json"), small_report_json);
+  EXPECT_TRUE(is_whole_document_dump(small_report_json));
+
+  EXPECT_EQ(s.frames_checked, 2);
+  ASSERT_TRUE(s.worst.has_value());
+  EXPECT_EQ(*s.worst, (WorstFrame{3, "cache/cloth.0003.obj", 1, 2}));
+  EXPECT_EQ(s.worst_frame, 0u);
+  EXPECT_TRUE(s.failed);
+}
+
+TEST(ReportStream, WholeReportWritersGiveTheSameHandWrittenBytes) {
+  const Report r =
+      whole_report("1.2.3", small_settings(), small_inputs(), small_frames(), 1, 0, 2.5);
+  std::ostringstream pairs, frames;
+  write_pairs_csv(pairs, r);
+  write_frames_csv(frames, r);
+  EXPECT_EQ(pairs.str(), small_pairs_csv);
+  EXPECT_EQ(frames.str(), small_frames_csv);
+  EXPECT_EQ(report_json(r), small_report_json);
+
+  TempDir tmp;
+  write_reports(tmp.path(), r);
+  EXPECT_EQ(read_all(tmp.path() / "report.json"), small_report_json);
+}
+
+TEST(ReportStream, EmptyRunHasHeadersAndEmptyArrays) {
+  TempDir tmp;
+  ReportStream stream(tmp.path(), "1.2.3", small_settings());
+  stream.finish(small_inputs(), 0, 0, 0.25);
+  EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), std::string(pairs_csv_header) + "\n");
+  EXPECT_EQ(read_all(tmp.path() / "frames.csv"), std::string(frames_csv_header) + "\n");
+  const std::string json = read_all(tmp.path() / "report.json");
+  EXPECT_NE(json.find("\n    \"files\": [],\n"), std::string::npos) << json;
+  EXPECT_NE(json.find("\n  \"frames\": [],\n"), std::string::npos) << json;
+  EXPECT_NE(json.find("\n    \"worst_frame\": null,\n"), std::string::npos) << json;
+  EXPECT_TRUE(is_whole_document_dump(json)) << json;
+  EXPECT_EQ(json,
+            report_json(whole_report("1.2.3", small_settings(), small_inputs(), {}, 0, 0, 0.25)));
+}
+
+/// A seeded random run: frames in increasing number with gaps, a third of them clean, up to
+/// 400 pairs each (unsorted in some records), degenerate faces, times with every digit
+/// significant, file names that need CSV quoting, JSON escapes or hold UTF-8.
+std::vector<FrameRecord> random_frames(uint32_t seed, int count) {
+  std::mt19937 rng(seed);
+  const auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); };
+  const auto seconds = [&] { return std::uniform_real_distribution<double>(0, 0.01)(rng); };
+  const std::vector<std::string> names = {"cloth",     "a,b",          "say \"hi\"",
+                                          "tab\there", "dr\xc3\xa9pe", "line\nbreak"};
+  std::vector<FrameRecord> frames;
+  int64_t number = uniform(-3, 3);
+  for (int i = 0; i < count; ++i) {
+    FrameRecord f;
+    f.frame = number;
+    number += uniform(1, 4);
+    f.file = "cache/" + names[uniform(0, static_cast<int>(names.size()) - 1)] + "." +
+             std::to_string(f.frame) + ".obj";
+    f.triangles = uniform(50, 5000);
+    f.vertices = f.triangles / 2 + 2;
+    f.polygons = f.triangles - uniform(0, 10);
+    if (uniform(0, 2) > 0) {
+      std::set<std::pair<int32_t, int32_t>> faces;
+      const int pairs = uniform(1, 400);
+      while (static_cast<int>(faces.size()) < pairs) {
+        const int32_t a = uniform(0, f.triangles - 2);
+        faces.insert({a, uniform(a + 1, f.triangles - 1)});
+      }
+      for (const auto& [a, b] : faces)
+        f.pairs.push_back(
+            {a, b, uniform(0, 3) == 0 ? PairKind::crossing : PairKind::touching, a / 2, b / 2});
+      if (uniform(0, 4) == 0) std::shuffle(f.pairs.begin(), f.pairs.end(), rng);
+    }
+    for (int d = uniform(-6, 3); d > 0; --d) f.degenerate.push_back({d * 7, d * 7 / 2});
+    std::reverse(f.degenerate.begin(), f.degenerate.end());
+    f.candidate_pairs = uniform(0, 100000);
+    f.filtered_tests = uniform(0, 100000);
+    f.uncertain_tests = uniform(-20, 5) > 0 ? uniform(1, 50) : 0;
+    f.confirmed_pairs = uniform(0, 1) ? static_cast<int64_t>(f.pairs.size()) : 0;
+    f.topology_changed = uniform(0, 9) == 0;
+    f.rebuilt = i == 0 || f.topology_changed || uniform(0, 5) == 0;
+    f.tree_quality = std::uniform_real_distribution<double>(1, 4)(rng);
+    f.times = {f.rebuilt ? seconds() : 0,
+               f.rebuilt ? 0 : seconds(),
+               seconds(),
+               seconds(),
+               seconds(),
+               f.confirmed_pairs ? seconds() : 0};
+    f.read_seconds = seconds();
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
+  for (uint32_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE("seed=" + std::to_string(seed));
+    Settings settings = small_settings();
+    settings.weld = 1e-5;
+    settings.frames.reset();
+    settings.fail_on = seed == 2 ? FailOn::crossing : FailOn::none;
+    Inputs inputs = small_inputs();
+    inputs.ids = "assimp";
+    inputs.coincident_vertices = seed;
+    const std::vector<FrameRecord> frames = random_frames(seed, 60);
+
+    TempDir tmp;
+    ReportStream stream(tmp.path(), "0.1.0", settings);
+    for (const FrameRecord& f : frames) stream.add(f);
+    const Summary streamed = stream.finish(inputs, 3, 2, 12.25);
+
+    const Report r = whole_report("0.1.0", settings, inputs, frames, 3, 2, 12.25);
+    std::ostringstream pairs, frames_csv;
+    write_pairs_csv(pairs, r);
+    write_frames_csv(frames_csv, r);
+    EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), pairs.str());
+    EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
+    const std::string json = read_all(tmp.path() / "report.json");
+    EXPECT_EQ(json, report_json(r));
+    EXPECT_TRUE(is_whole_document_dump(json));
+    EXPECT_TRUE(streamed == summarize(r));
+  }
+}
+
+TEST(ReportStream, WrittenProgressivelyIntoHiddenTemporaries) {
+  TempDir tmp;
+  ReportStream stream(tmp.path(), "1.2.3", small_settings());
+  for (const FrameRecord& f : small_frames()) stream.add(f);
+  // Before finish(): only hidden temporaries, of the three reports and report.json's spools.
+  const std::vector<std::string> names = entries(tmp.path());
+  ASSERT_EQ(names.size(), 5u);
+  for (const std::string& name : names) {
+    EXPECT_EQ(name[0], '.') << name;
+    EXPECT_NE(name.find(".tmp-"), std::string::npos) << name;
+  }
+  stream.finish(small_inputs(), 1, 0, 2.5);
+  EXPECT_EQ(entries(tmp.path()),
+            (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+}
+
+/// An earlier run's reports, to be kept by a run that fails.
+void write_earlier_run(const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "pairs.csv") << "old pairs";
+  std::ofstream(dir / "frames.csv") << "old frames";
+  std::ofstream(dir / "report.json") << "old report";
+}
+
+void expect_earlier_run(const fs::path& dir) {
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+  EXPECT_EQ(read_all(dir / "pairs.csv"), "old pairs");
+  EXPECT_EQ(read_all(dir / "frames.csv"), "old frames");
+  EXPECT_EQ(read_all(dir / "report.json"), "old report");
+}
+
+TEST(ReportStream, ExceptionMidRunLeavesNoFileAndKeepsTheEarlierRun) {
+  TempDir tmp;
+  write_earlier_run(tmp.path());
+  const auto run_failing_at_the_third_frame = [&] {
+    ReportStream stream(tmp.path(), "1.2.3", small_settings());
+    for (const FrameRecord& f : small_frames()) stream.add(f);
+    throw std::runtime_error("frame 5: malformed");
+  };
+  EXPECT_THROW(run_failing_at_the_third_frame(), std::runtime_error);
+  expect_earlier_run(tmp.path());
+}
+
+TEST(ReportStream, NoFinishLeavesNothingInAFreshDirectory) {
+  TempDir tmp;
+  const fs::path out = tmp.path() / "new";
+  {
+    ReportStream stream(out, "1.2.3", small_settings());
+    stream.add(small_frames()[0]);
+  }
+  EXPECT_TRUE(entries(out).empty());
+}
+
+/// Lowers the process's file size limit (RLIMIT_FSIZE) so that writes past `bytes` fail with
+/// EFBIG as on a full disk, with SIGXFSZ ignored; both restored on destruction. Works as root.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    old_handler_ = ::signal(SIGXFSZ, SIG_IGN);
+    ::getrlimit(RLIMIT_FSIZE, &old_limit_);
+    rlimit lowered = old_limit_;
+    lowered.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &lowered);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &old_limit_);
+    ::signal(SIGXFSZ, old_handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit old_limit_{};
+  sighandler_t old_handler_;
+};
+
+TEST(ReportStream, FullDiskIsAWriteErrorAndLeavesNoFile) {
+  TempDir tmp;
+  write_earlier_run(tmp.path());
+  // One frame of 20,000 pairs: about 0.5 MB of pairs.csv rows, and more of JSON.
+  FrameRecord big = small_frames()[1];
+  for (int32_t a = 0; a < 20000; ++a) big.pairs.push_back({a, a + 1, PairKind::touching, a, a});
+  const auto run = [&] {
+    FileSizeLimit limit(64 * 1024);
+    ReportStream stream(tmp.path(), "1.2.3", small_settings());
+    stream.add(big);
+    stream.finish(small_inputs(), 1, 0, 1.0);
+  };
+  try {
+    run();
+    ADD_FAILURE() << "no WriteError past the file size limit";
+  } catch (const WriteError& e) {
+    EXPECT_NE(std::string(e.what()).find("write failed"), std::string::npos) << e.what();
+    EXPECT_EQ(e.path().parent_path(), tmp.path());
+  }
+  expect_earlier_run(tmp.path());
+}
+
+TEST(ReportStream, UnusableDirectoryFailsAtOnce) {
+  TempDir tmp;
+  std::ofstream(tmp.path() / "a-file") << "x";
+  EXPECT_THROW(ReportStream(tmp.path() / "a-file", "1.2.3", small_settings()), WriteError);
+  EXPECT_THROW(ReportStream(tmp.path() / "a-file" / "below", "1.2.3", small_settings()),
+               WriteError);
+  EXPECT_EQ(entries(tmp.path()), std::vector<std::string>{"a-file"});
+  EXPECT_EQ(read_all(tmp.path() / "a-file"), "x");
+}
+
+TEST(ReportStream, FramesOutOfOrderOrAfterFinishAreInternalErrors) {
+  ReportStream stream(std::nullopt, "1.2.3", small_settings());
+  const std::vector<FrameRecord> frames = small_frames();
+  stream.add(frames[1]);
+  stream.add(frames[1]);  // the same number again keeps the order
+  EXPECT_THROW(stream.add(frames[0]), InternalError);
+  stream.finish(small_inputs(), 1, 0, 1.0);
+  EXPECT_THROW(stream.add(frames[1]), InternalError);
+  EXPECT_THROW(stream.finish(small_inputs(), 1, 0, 1.0), InternalError);
+}
+
+TEST(ReportStream, WithoutDirectoryKeepsTheSummaryOnly) {
+  ReportStream stream(std::nullopt, "1.2.3", small_settings());
+  for (const FrameRecord& f : small_frames()) stream.add(f);
+  const Summary s = stream.finish(small_inputs(), 1, 0, 2.5);
+  EXPECT_TRUE(s == summarize(whole_report("1.2.3", small_settings(), small_inputs(), small_frames(),
+                                          1, 0, 2.5)));
+}
+
+/// The summary recounted from scratch over frames[0, n): every count by walking the pairs, the
+/// worst frame as the maximum of (crossing, pairs, -position) over frames with a pair.
+void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n, FailOn fail_on,
+                                const Summary& s) {
+  int64_t with_crossings = 0, with_pairs = 0, pairs = 0, crossing = 0, degenerate = 0;
+  int64_t uncertain = 0, confirmed = 0, topology = 0;
+  double check = 0, read = 0;
+  std::optional<size_t> worst;
+  std::tuple<int64_t, int64_t, int64_t> worst_key{-1, -1, 0};
+  for (size_t i = 0; i < n; ++i) {
+    const FrameRecord& f = frames[i];
+    int64_t frame_crossing = 0;
+    for (const Pair& p : f.pairs) frame_crossing += p.kind == PairKind::crossing;
+    const int64_t frame_pairs = static_cast<int64_t>(f.pairs.size());
+    with_crossings += frame_crossing > 0;
+    with_pairs += frame_pairs > 0;
+    pairs += frame_pairs;
+    crossing += frame_crossing;
+    degenerate += static_cast<int64_t>(f.degenerate.size());
+    uncertain += f.uncertain_tests;
+    confirmed += f.confirmed_pairs;
+    topology += f.topology_changed ? 1 : 0;
+    check += f.times.total();
+    read += f.read_seconds;
+    const std::tuple<int64_t, int64_t, int64_t> key{frame_crossing, frame_pairs,
+                                                    -static_cast<int64_t>(i)};
+    if (frame_pairs > 0 && key > worst_key) {
+      worst_key = key;
+      worst = i;
+    }
+  }
+  EXPECT_EQ(s.frames_checked, static_cast<int64_t>(n));
+  EXPECT_EQ(s.frames_with_crossings, with_crossings);
+  EXPECT_EQ(s.frames_with_pairs, with_pairs);
+  EXPECT_EQ(s.pairs, pairs);
+  EXPECT_EQ(s.crossing, crossing);
+  EXPECT_EQ(s.touching, pairs - crossing);
+  EXPECT_EQ(s.degenerate, degenerate);
+  EXPECT_EQ(s.uncertain_tests, uncertain);
+  EXPECT_EQ(s.confirmed_pairs, confirmed);
+  EXPECT_EQ(s.topology_changes, topology);
+  EXPECT_DOUBLE_EQ(s.check_seconds, check);
+  EXPECT_DOUBLE_EQ(s.read_seconds, read);
+  EXPECT_EQ(s.worst_frame, worst);
+  ASSERT_EQ(s.worst.has_value(), worst.has_value());
+  if (worst) {
+    const FrameRecord& w = frames[*worst];
+    EXPECT_EQ(s.worst->frame, w.frame);
+    EXPECT_EQ(s.worst->file, w.file);
+    EXPECT_EQ(s.worst->crossing, std::get<0>(worst_key));
+    EXPECT_EQ(s.worst->pairs, static_cast<int64_t>(w.pairs.size()));
+  }
+  const bool failed = fail_on == FailOn::crossing ? crossing > 0
+                      : fail_on == FailOn::any    ? pairs > 0
+                                                  : false;
+  EXPECT_EQ(s.failed, failed);
+}
+
+TEST(SummaryAccumulator, MatchesABruteForceRecountAfterEveryFrame) {
+  for (uint32_t seed : {11u, 12u, 13u, 14u}) {
+    SCOPED_TRACE("seed=" + std::to_string(seed));
+    std::vector<FrameRecord> frames = random_frames(seed, 80);
+    // Ties for the worst frame: the same counts again later must not take its place.
+    frames[40].pairs = frames[20].pairs;
+    frames[41].pairs = frames[20].pairs;
+    for (FailOn fail_on : {FailOn::crossing, FailOn::any, FailOn::none}) {
+      SummaryAccumulator accumulator(fail_on);
+      expect_brute_force_summary(frames, 0, fail_on, accumulator.summary());
+      for (size_t n = 1; n <= frames.size(); ++n) {
+        accumulator.add(frames[n - 1]);
+        SCOPED_TRACE("after " + std::to_string(n) + " frames");
+        expect_brute_force_summary(frames, n, fail_on, accumulator.summary());
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace snag::report
