@@ -10,7 +10,7 @@ DEMO_REPORT := $(BUILD)/demo-report
 # Everything the build and the tests need, as Debian 12 packages.
 DEBIAN_PACKAGES := cmake g++ make libcgal-dev libassimp-dev libeigen3-dev libcli11-dev \
   nlohmann-json3-dev libfast-float-dev libgtest-dev libgmock-dev googletest \
-  libmpfr-dev libgmp-dev
+  libmpfr-dev libgmp-dev libtinyobjloader-dev
 # apt-get needs root; use sudo when make runs as another user.
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

@@ -13,16 +13,14 @@
 #include <vector>
 
 #include "backend_factory.h"
+#include "check_sequence.h"
 #include "commands.h"
 #include "progress.h"
 #include "snag/detect/checker.h"
 #include "snag/error.h"
-#include "snag/io/read_mesh.h"
-#include "snag/mesh/weld.h"
 #include "snag/report/report.h"
 #include "snag/report/stream.h"
 #include "snag/report/write.h"
-#include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
 #include "snag/validators/exact_modes.h"
 
@@ -47,14 +45,6 @@ std::vector<seq::Frame> resolve_frames(const CheckOptions& options) {
   std::vector<seq::Frame> frames = seq::resolve_sequence(options.sequence);
   if (options.frames.empty()) return frames;
   return seq::select_frames(frames, seq::FrameSelection::parse(options.frames));
-}
-
-bool same_faces(const std::vector<geom::Tri>& a, const std::vector<geom::Tri>& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      if (a[i].v[k] != b[i].v[k]) return false;
-  return true;
 }
 
 std::string frame_note(const report::FrameRecord& r) {
@@ -222,74 +212,21 @@ int run_check(const CheckOptions& o) {
   report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings));
 
   Progress progress(static_cast<int64_t>(frames.size()), o.quiet);
-  std::vector<geom::Tri> file_triangles;  // the current topology, as the file lists it
-  std::vector<int32_t> representative;    // weld representative per vertex (empty: no weld)
-  int32_t vertex_count = 0;
-  std::string first_file;
-  bool any_assimp = false;
-
-  // Frames are read ahead on their own threads while the current one is checked; at most
-  // `depth` frames are held at once whatever the sequence length.
-  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
-  const int readers = std::clamp(threads / 4, 1, 4);
-  seq::FramePrefetcher prefetcher(frames, readers, readers + 2,
-                                  [](const seq::Frame& f) { return io::read_mesh(f.path); });
-  while (std::optional<seq::PrefetchedFrame> next = prefetcher.next()) {
-    const size_t i = next->index;
-    const seq::Frame& frame = frames[i];
-    const std::string file = frame.path.string();
-    const auto read_started = Clock::now();  // welding counts as reading
-    mesh::Mesh mesh = std::move(next->mesh);
-    any_assimp = any_assimp || mesh.ids_from_assimp;
-    const int32_t vertices = static_cast<int32_t>(mesh.positions.size());
-
-    bool topology_changed = false;
-    if (i == 0) {
-      vertex_count = vertices;
-      first_file = file;
-    } else if (vertices != vertex_count) {
-      throw InputError(file, 0,
-                       "has " + std::to_string(vertices) + " vertices, but the first frame (" +
-                           first_file + ") has " + std::to_string(vertex_count) +
-                           "; every frame of a sequence must have the same vertices");
-    } else {
-      topology_changed = !same_faces(mesh.triangles, file_triangles);
-    }
-
-    if (i == 0 || topology_changed) {
-      // Welding is decided once per topology, on its first frame: seams stay closed while the
-      // cloth moves, and a weld that changed from frame to frame would rebuild the tree.
-      if (o.weld) {
-        representative = mesh::weld_representatives(mesh.positions, *o.weld);
-        int64_t welded = 0;
-        for (size_t v = 0; v < representative.size(); ++v)
-          welded += representative[v] != static_cast<int32_t>(v);
-        if (i == 0) inputs.welded_vertices = welded;
-      } else if (i == 0) {
-        const int64_t coincident = mesh::count_coincident_vertices(mesh.positions);
-        inputs.coincident_vertices = coincident;
-        if (coincident > 0 && !o.quiet)
-          progress.message("snag: warning: " + file + ": " + std::to_string(coincident) +
-                           (coincident == 1 ? " vertex coincides" : " vertices coincide") +
-                           " exactly with another vertex but are separate vertices; "
-                           "unwelded seams are reported as intersections (use --weld TOL)");
-      }
-      file_triangles = mesh.triangles;
-      checker->set_triangles(mesh::welded_triangles(mesh.triangles, representative), vertex_count);
-    }
-    const double read_seconds = next->read_seconds + seconds_since(read_started);
-
-    const detect::FrameResult result = checker->check(mesh.positions);
-    report::FrameRecord record = report::make_frame_record(
-        frame.number, file, result, mesh.source_polygon, vertices, mesh.polygon_count);
-    record.topology_changed = topology_changed;
-    record.read_seconds = read_seconds;
-    progress.update(static_cast<int64_t>(i) + 1, frame_note(record));
-    reports.add(record);
-  }
+  SequenceSettings sequence;
+  sequence.weld = o.weld;
+  sequence.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  sequence.gpu = backend_name == "cuda";
+  check_sequence(
+      frames, *checker, sequence, inputs,
+      [&](report::FrameRecord&& record) {
+        progress.update(reports.summary().frames_checked + 1, frame_note(record));
+        reports.add(std::move(record));
+      },
+      [&](const std::string& warning) {
+        if (!o.quiet) progress.message("snag: warning: " + warning);
+      });
   progress.finish();
 
-  inputs.ids = any_assimp ? "assimp" : "file";
   RunTotals totals;
   totals.builds = checker->build_count();
   totals.rebuilds = checker->rebuild_count();

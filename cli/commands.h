@@ -81,4 +81,21 @@ struct BenchAccuracyOptions {
 CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& options);
 int run_bench_accuracy(const BenchAccuracyOptions& options);
 
+/// Options of `snag bench io`, filled by CLI11.
+struct BenchIoOptions {
+  int size = 35992;
+  int frames = 200;
+  int passes = 5;
+  std::vector<int> memory_frames = {10, 1000};
+  std::string data_dir;
+  std::vector<std::string> inputs;
+  std::string generator;
+  int threads = 0;
+  int device = 0;
+};
+
+/// Adds the `io` subcommand to `bench`; returns it.
+CLI::App* add_bench_io_command(CLI::App& bench, BenchIoOptions& options);
+int run_bench_io(const BenchIoOptions& options);
+
 }  // namespace snag::cli

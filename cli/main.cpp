@@ -4,6 +4,7 @@
 //   0 clean, 1 intersections found (per --fail-on; returned by the command, not thrown),
 //   2 usage error, 3 input or output error, 4 internal error or no usable CUDA device when one
 //   was asked for.
+#include <malloc.h>
 #include <CLI/CLI.hpp>
 
 #include <exception>
@@ -15,6 +16,13 @@
 #include "snag/report/write.h"
 
 int main(int argc, char** argv) {
+  // Every frame allocates and frees the same few large arrays (positions, faces, report text)
+  // on reader threads and the checker's. glibc serves blocks above its mmap threshold with a
+  // fresh mmap and returns them with munmap, whose TLB shootdown interrupts every core running
+  // the checker's threads: keep such blocks in the heap for reuse instead. Memory stays that of
+  // the largest frames in flight.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   CLI::App app{
       "snag finds where a cloth animation goes through itself: every intersecting "
       "triangle pair of every frame, labelled crossing or touching.",
@@ -32,6 +40,9 @@ int main(int argc, char** argv) {
     snag::cli::BenchAccuracyOptions bench_accuracy;
     CLI::App* bench_accuracy_command =
         snag::cli::add_bench_accuracy_command(*app.get_subcommand("bench"), bench_accuracy);
+    snag::cli::BenchIoOptions bench_io;
+    CLI::App* bench_io_command =
+        snag::cli::add_bench_io_command(*app.get_subcommand("bench"), bench_io);
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
@@ -42,6 +53,7 @@ int main(int argc, char** argv) {
     if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);
     if (bench_gpu_command->parsed()) return snag::cli::run_bench_gpu(bench_gpu);
     if (bench_accuracy_command->parsed()) return snag::cli::run_bench_accuracy(bench_accuracy);
+    if (bench_io_command->parsed()) return snag::cli::run_bench_io(bench_io);
     throw snag::InternalError("no subcommand ran");
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.

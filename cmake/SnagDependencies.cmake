@@ -7,6 +7,8 @@ find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(FastFloat REQUIRED)
 find_package(Threads REQUIRED)
+# Benchmark only (`snag bench io` reads the same frames with it); optional.
+find_package(tinyobjloader QUIET)
 if(SNAG_BUILD_TESTS)
   find_package(GTest REQUIRED)
   include(GoogleTest)

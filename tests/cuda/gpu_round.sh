@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One round on a GPU machine, from the repository root, with the build staged by
 # ../shared/gpu/stage into .gpu (see tests/cuda/README in the final report):
-#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [accuracy]
+#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [accuracy] [io]
 # Logs go to $OUT (or ./out); a short table is printed last.
 set -uo pipefail
 out=${OUT:-out}; mkdir -p "$out"
@@ -76,6 +76,10 @@ PY
       snag bench accuracy --data "$SNAG_DATA_DIR" --out "$out/accuracy" >"$out/bench_accuracy.txt" 2>"$out/bench_accuracy.err"; rc=$?
       summary+=("bench accuracy    rc=$rc")
       ;;
+    io)
+      snag bench io --data "$SNAG_DATA_DIR" ${IO_ARGS:-} >"$out/bench_io.txt" 2>"$out/bench_io.err"; rc=$?
+      summary+=("bench io          rc=$rc")
+      ;;
     bench-quick)
       snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
       summary+=("bench gpu (quick) rc=$rc")
@@ -84,4 +88,5 @@ PY
   summary[-1]="${summary[-1]}  [$(( $(date +%s) - t0 )) s]"
 done
 [ -f "$out/bench_gpu.txt" ] && cat "$out/bench_gpu.txt"
+[ -f "$out/bench_io.txt" ] && cat "$out/bench_io.txt"
 printf '%s\n' "${summary[@]}"

@@ -5,7 +5,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <map>
+#include <mutex>
 #include <random>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -38,7 +41,7 @@ TEST(FramePrefetcher, FramesComeOutInOrderOnceEach) {
     for (int depth : {1, 3, 8}) {
       std::atomic<int> reading{0}, peak{0};
       FramePrefetcher prefetcher(numbered(60), readers, depth,
-                                 [&](const Frame& f) { return slow_read(f, reading, peak); });
+                                 [&](const Frame& f, int) { return slow_read(f, reading, peak); });
       size_t expected = 0;
       while (auto next = prefetcher.next()) {
         ASSERT_EQ(next->index, expected) << readers << " readers, depth " << depth;
@@ -56,7 +59,7 @@ TEST(FramePrefetcher, FramesComeOutInOrderOnceEach) {
 TEST(FramePrefetcher, HoldsNoMoreThanDepthFramesForASlowConsumer) {
   std::atomic<int> reading{0}, peak{0};
   FramePrefetcher prefetcher(numbered(200), 3, 4,
-                             [&](const Frame& f) { return slow_read(f, reading, peak); });
+                             [&](const Frame& f, int) { return slow_read(f, reading, peak); });
   int taken = 0;
   while (auto next = prefetcher.next()) {
     if (taken++ % 20 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -67,7 +70,7 @@ TEST(FramePrefetcher, HoldsNoMoreThanDepthFramesForASlowConsumer) {
 }
 
 TEST(FramePrefetcher, AReadersErrorIsThrownAtItsFramesTurn) {
-  FramePrefetcher prefetcher(numbered(30), 4, 6, [](const Frame& f) {
+  FramePrefetcher prefetcher(numbered(30), 4, 6, [](const Frame& f, int) {
     if (f.number == 17) throw std::runtime_error("bad frame 17");
     mesh::Mesh m;
     m.positions.push_back({static_cast<double>(f.number), 0, 0});
@@ -84,13 +87,39 @@ TEST(FramePrefetcher, AReadersErrorIsThrownAtItsFramesTurn) {
 TEST(FramePrefetcher, DroppingItEarlyStopsTheReaders) {
   std::atomic<int> reads{0};
   {
-    FramePrefetcher prefetcher(numbered(1000), 2, 3, [&](const Frame&) {
+    FramePrefetcher prefetcher(numbered(1000), 2, 3, [&](const Frame&, int) {
       ++reads;
       return mesh::Mesh{};
     });
     ASSERT_TRUE(prefetcher.next());
   }  // must return: readers waiting for room are woken and leave
   EXPECT_LE(reads.load(), 1 + 3);
+}
+
+TEST(FramePrefetcher, EachReaderThreadHasItsOwnIndex) {
+  // Per-reader state (an io::FrameReader each) is safe only if an index belongs to one thread.
+  std::mutex mutex;
+  std::map<int, std::set<std::thread::id>> threads_of_index;
+  {
+    std::atomic<int> reading{0}, peak{0};
+    FramePrefetcher prefetcher(numbered(200), 3, 5, [&](const Frame& f, int reader) {
+      {
+        std::lock_guard lock(mutex);
+        threads_of_index[reader].insert(std::this_thread::get_id());
+      }
+      return slow_read(f, reading, peak);
+    });
+    while (prefetcher.next()) {
+    }
+  }
+  std::set<std::thread::id> all;
+  for (const auto& [index, threads] : threads_of_index) {
+    EXPECT_GE(index, 0);
+    EXPECT_LT(index, 3);
+    EXPECT_EQ(threads.size(), 1u) << "index " << index;
+    all.insert(threads.begin(), threads.end());
+  }
+  EXPECT_EQ(all.size(), threads_of_index.size());  // and a thread has one index
 }
 
 }  // namespace

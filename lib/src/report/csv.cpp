@@ -1,9 +1,11 @@
 #include "snag/report/csv.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cinttypes>
 #include <cstdio>
 #include <numeric>
+#include <string_view>
 #include <vector>
 
 namespace snag::report {
@@ -35,14 +37,24 @@ std::string csv_field(std::string_view field) {
 }
 
 void write_pairs_rows(std::ostream& out, const FrameRecord& f) {
-  // snprintf into a line buffer: a 100K-pair frame is written in milliseconds, and the bytes
-  // do not depend on the stream's locale or flags.
+  // std::to_chars into a line buffer: a 100K-pair frame is written in milliseconds, and the
+  // bytes do not depend on the stream's locale or flags.
   char line[128];
+  char* const after_frame = std::to_chars(line, line + 24, f.frame).ptr;
+  *after_frame = ',';
   const auto write_row = [&](const Pair& p) {
-    const int n = std::snprintf(line, sizeof line, "%" PRId64 ",%d,%d,%s,%d,%d\n", f.frame, p.a,
-                                p.b, p.kind == detect::PairKind::crossing ? "crossing" : "touching",
-                                p.poly_a, p.poly_b);
-    out.write(line, n);
+    char* q = after_frame + 1;
+    q = std::to_chars(q, q + 12, p.a).ptr;
+    *q++ = ',';
+    q = std::to_chars(q, q + 12, p.b).ptr;
+    const std::string_view kind =
+        p.kind == detect::PairKind::crossing ? ",crossing," : ",touching,";
+    q = std::copy(kind.begin(), kind.end(), q);
+    q = std::to_chars(q, q + 12, p.poly_a).ptr;
+    *q++ = ',';
+    q = std::to_chars(q, q + 12, p.poly_b).ptr;
+    *q++ = '\n';
+    out.write(line, q - line);
   };
   const auto by_faces = [](const Pair& x, const Pair& y) {
     return x.a != y.a ? x.a < y.a : x.b < y.b;

@@ -1,10 +1,12 @@
 #include "snag/report/json.h"
 
+#include <charconv>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "json_layout.h"
+#include "snag/error.h"
 
 namespace snag::report {
 
@@ -13,20 +15,15 @@ namespace {
 using nlohmann::ordered_json;
 
 ordered_json seconds_json(const FrameRecord& f) {
-  return {{"read", f.read_seconds},       {"build", f.times.build}, {"refit", f.times.refit},
-          {"traverse", f.times.traverse}, {"exact", f.times.exact}, {"classify", f.times.classify},
+  return {{"read", f.read_seconds},       {"build", f.times.build},  {"refit", f.times.refit},
+          {"traverse", f.times.traverse}, {"exact", f.times.exact},  {"classify", f.times.classify},
           {"confirm", f.times.confirm},   {"total", f.times.total()}};
 }
 
+/// A frame's record without its pairs (an empty array in their place: json_frame_element
+/// writes them, the one part of the report that grows with the pairs).
 ordered_json frame_json(const FrameRecord& f) {
   const int64_t crossing = f.crossing_count();
-  ordered_json pairs = ordered_json::array();
-  for (const Pair& p : f.pairs)
-    pairs.push_back({{"a", p.a},
-                     {"b", p.b},
-                     {"kind", std::string(detect::to_string(p.kind))},
-                     {"poly_a", p.poly_a},
-                     {"poly_b", p.poly_b}});
   ordered_json degenerate = ordered_json::array();
   for (const Face& d : f.degenerate) degenerate.push_back({{"face", d.face}, {"poly", d.poly}});
   ordered_json j;
@@ -47,7 +44,7 @@ ordered_json frame_json(const FrameRecord& f) {
                  {"uncertain_tests", f.uncertain_tests},
                  {"confirmed_pairs", f.confirmed_pairs}};
   j["seconds"] = seconds_json(f);
-  j["pairs"] = std::move(pairs);
+  j["pairs"] = ordered_json::array();
   j["degenerate"] = std::move(degenerate);
   return j;
 }
@@ -129,8 +126,57 @@ std::string json_file_element(const std::string& file, bool first) {
   return array_element(ordered_json(file), files_level, first);
 }
 
+/// The pairs array of a frame record, laid out as dump(2) lays out the same objects when the
+/// array's member line is indented `level` times. Written by hand: a frame can have millions
+/// of pairs, and building a JSON object per pair cost more than checking the frame.
+std::string pairs_array(const std::vector<Pair>& pairs, int level) {
+  const std::string object_margin = indent(level + 1), member_margin = indent(level + 2);
+  std::string out = "[";
+  out.reserve(pairs.size() * (6 * member_margin.size() + 96));
+  char number[16];
+  const auto add_member = [&](const char* key, int32_t value, bool last) {
+    out += member_margin;
+    out += key;
+    const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
+    out.append(number, end);
+    out += last ? "\n" : ",\n";
+  };
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const Pair& p = pairs[i];
+    out += i == 0 ? "\n" : ",\n";
+    out += object_margin;
+    out += "{\n";
+    add_member("\"a\": ", p.a, false);
+    add_member("\"b\": ", p.b, false);
+    out += member_margin;
+    out += p.kind == detect::PairKind::crossing ? "\"kind\": \"crossing\",\n"
+                                                : "\"kind\": \"touching\",\n";
+    add_member("\"poly_a\": ", p.poly_a, false);
+    add_member("\"poly_b\": ", p.poly_b, true);
+    out += object_margin;
+    out += '}';
+  }
+  if (!pairs.empty()) {
+    out += '\n';
+    out += indent(level);
+  }
+  out += ']';
+  return out;
+}
+
 std::string json_frame_element(const FrameRecord& frame, bool first) {
-  return array_element(frame_json(frame), frames_level, first);
+  std::string text = array_element(frame_json(frame), frames_level, first);
+  if (frame.pairs.empty()) return text;
+  // The record's members sit two levels inside the frames array's line; its "pairs" member
+  // is the only one at that indentation whose value is [] (a string value cannot hold an
+  // unescaped quote, so no file name can look like it).
+  const int member_level = frames_level + 2;
+  const std::string placeholder = "\n" + indent(member_level) + "\"pairs\": []";
+  const size_t at = text.find(placeholder);
+  if (at == std::string::npos)
+    throw InternalError("report.json: no pairs member in a frame record");
+  text.replace(at + placeholder.size() - 2, 2, pairs_array(frame.pairs, member_level));
+  return text;
 }
 
 void write_report_json(std::ostream& out, const Report& run, const Summary& summary,

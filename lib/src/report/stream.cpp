@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <utility>
 #include <vector>
 
 #include "json_layout.h"
@@ -62,15 +63,66 @@ ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version
   files_ = std::make_unique<Files>(*dir);
   files_->pairs_csv.out() << pairs_csv_header << '\n';
   files_->frames_csv.out() << frames_csv_header << '\n';
+  writer_ = std::thread([this] { write_loop(); });
 }
 
-ReportStream::~ReportStream() = default;  // files_'s StagedFiles removes what was not renamed
+// files_'s StagedFiles then removes what was not renamed.
+ReportStream::~ReportStream() {
+  stop_writer();
+}
+
+void ReportStream::write_loop() {
+  bool first = true;
+  for (;;) {
+    std::unique_lock lock(mutex_);
+    handed_over_.wait(lock, [&] { return closing_ || !unwritten_.empty(); });
+    if (unwritten_.empty()) return;  // closing, all written
+    // The frame stays in the queue while it is written: add() counts it as unwritten.
+    const FrameRecord& frame = unwritten_.front();
+    lock.unlock();
+    std::exception_ptr error;
+    if (!write_error_) {  // after a failure the rest is dropped: the run is lost anyway
+      try {
+        write_frame(frame, first);
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+    first = false;
+    lock.lock();
+    if (error) write_error_ = error;
+    unwritten_.pop_front();
+    lock.unlock();
+    written_.notify_all();
+  }
+}
+
+void ReportStream::write_frame(const FrameRecord& frame, bool first) {
+  write_pairs_rows(files_->pairs_csv.out(), frame);
+  write_frames_row(files_->frames_csv.out(), frame);
+  files_->file_names.out() << json_file_element(frame.file, first);
+  files_->frame_records.out() << json_frame_element(frame, first);
+  for (const StagedFile* f :
+       {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->frame_records})
+    f->check();
+}
+
+std::exception_ptr ReportStream::stop_writer() {
+  if (!writer_.joinable()) return write_error_;
+  {
+    std::lock_guard lock(mutex_);
+    closing_ = true;
+  }
+  handed_over_.notify_all();
+  writer_.join();
+  return write_error_;
+}
 
 const Summary& ReportStream::summary() const {
   return accumulator_.summary();
 }
 
-void ReportStream::add(const FrameRecord& frame) {
+void ReportStream::add(FrameRecord frame) {
   if (finished_)
     throw InternalError("report: frame " + std::to_string(frame.frame) +
                         " added after the report was finished");
@@ -78,19 +130,16 @@ void ReportStream::add(const FrameRecord& frame) {
     throw InternalError("report: frame " + std::to_string(frame.frame) + " added after frame " +
                         std::to_string(*last_frame_) +
                         "; frames must come in increasing frame number");
-  if (files_) {
-    const bool first = accumulator_.summary().frames_checked == 0;
-    write_pairs_rows(files_->pairs_csv.out(), frame);
-    write_frames_row(files_->frames_csv.out(), frame);
-    files_->file_names.out() << json_file_element(frame.file, first);
-    files_->frame_records.out() << json_frame_element(frame, first);
-    // A failed write is reported at the frame it hit, not at the end of the run.
-    for (const StagedFile* f :
-         {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->frame_records})
-      f->check();
-  }
   accumulator_.add(frame);
   last_frame_ = frame.frame;
+  if (!files_) return;
+  {
+    std::unique_lock lock(mutex_);
+    written_.wait(lock, [&] { return unwritten_.size() < write_ahead || write_error_; });
+    if (write_error_) std::rethrow_exception(write_error_);
+    unwritten_.push_back(std::move(frame));
+  }
+  handed_over_.notify_one();
 }
 
 Summary ReportStream::finish(const Inputs& inputs, int builds, int rebuilds, double wall_seconds) {
@@ -102,6 +151,7 @@ Summary ReportStream::finish(const Inputs& inputs, int builds, int rebuilds, dou
   run_.wall_seconds = wall_seconds;
   const Summary summary = accumulator_.summary();
   if (files_) {
+    if (const std::exception_ptr error = stop_writer()) std::rethrow_exception(error);
     // The spools are closed (flushed, checked) before they are read back.
     files_->file_names.close();
     files_->frame_records.close();

@@ -11,7 +11,7 @@ FramePrefetcher::FramePrefetcher(std::vector<Frame> frames, int readers, int dep
       depth_(static_cast<size_t>(std::max(depth, 1))),
       slots_(depth_) {
   const int count = std::max(1, std::min<int>(readers, static_cast<int>(depth_)));
-  for (int t = 0; t < count; ++t) threads_.emplace_back([this] { read_loop(); });
+  for (int t = 0; t < count; ++t) threads_.emplace_back([this, t] { read_loop(t); });
 }
 
 FramePrefetcher::~FramePrefetcher() {
@@ -23,7 +23,7 @@ FramePrefetcher::~FramePrefetcher() {
   for (std::thread& t : threads_) t.join();
 }
 
-void FramePrefetcher::read_loop() {
+void FramePrefetcher::read_loop(int reader) {
   for (;;) {
     size_t index;
     {
@@ -41,7 +41,7 @@ void FramePrefetcher::read_loop() {
     Slot result;
     const auto started = std::chrono::steady_clock::now();
     try {
-      result.frame.mesh = read_(frames_[index]);
+      result.frame.mesh = read_(frames_[index], reader);
     } catch (...) {
       result.error = std::current_exception();
     }

@@ -2,23 +2,29 @@
 // appear all at once at the end, complete, or not at all, while memory stays bounded however
 // long the sequence is.
 //
-// Each frame's rows are appended, as the frame is added, to hidden temporaries in the output
-// directory: its pairs.csv rows and frames.csv row to the temporaries that become those files,
-// its report.json record and file name to two scratch spools. finish() writes report.json as
-// its head (schema, version, settings, inputs with the spooled file names), the spooled frame
-// records and the summary, then renames the three files into place. What the stream holds is
-// a fixed amount: the settings, the summary accumulator (counts, and the worst frame's number,
-// file and counts) and the stream buffers; the caller can drop each frame once it is added.
+// Each frame's rows are appended, by the stream's writer thread soon after the frame is
+// added, to hidden temporaries in the output directory: its pairs.csv rows and frames.csv row to
+// the temporaries that become those files, its report.json record and file name to two scratch
+// spools. finish() writes report.json as its head (schema, version, settings, inputs with the
+// spooled file names), the spooled frame records and the summary, then renames the three files into
+// place. What the stream holds is a fixed amount: the settings, the summary accumulator (counts,
+// and the worst frame's number, file and counts), the stream buffers and at most write_ahead frames
+// not yet written.
 //
 // The bytes are those of write_pairs_csv, write_frames_csv and report_json for the same frames
 // (one formatter per row and record serves both: csv.h, json.cpp).
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "snag/report/report.h"
 
@@ -41,8 +47,16 @@ class ReportStream {
   /// Appends a checked frame's rows. Frames must come in non-decreasing frame number (the
   /// order of checking, which the CSV files promise); an earlier number throws InternalError.
   /// `frame.pairs` in any order (the CSV sorts them by (a, b), report.json keeps the record's
-  /// order, as the whole-report writers do). Throws WriteError when a write fails.
-  void add(const FrameRecord& frame);
+  /// order, as the whole-report writers do).
+  ///
+  /// The rows are formatted and written by the stream's own thread, so that a frame with
+  /// millions of pairs does not hold up the check of the next: add() hands the record over
+  /// and returns, waiting only while write_ahead frames are still unwritten. A failed write
+  /// throws WriteError from the next add() or from finish().
+  void add(FrameRecord frame);
+
+  /// Frames handed over and not yet written, at most: what the memory bound is counted in.
+  static constexpr size_t write_ahead = 4;
 
   /// The summary of the frames added so far (worst_frame counts them in the order added).
   const Summary& summary() const;
@@ -57,11 +71,25 @@ class ReportStream {
  private:
   struct Files;  // the temporaries, absent without an output directory
 
+  void write_loop();
+  void write_frame(const FrameRecord& frame, bool first);
+  /// Waits until every frame handed over is written, then stops the writer thread. Returns
+  /// its error, if a write failed.
+  std::exception_ptr stop_writer();
+
   Report run_;  ///< report.json's head and totals; its frames stay empty
   SummaryAccumulator accumulator_;
   std::optional<int64_t> last_frame_;
   std::unique_ptr<Files> files_;
   bool finished_ = false;
+
+  // The writer thread and the frames handed to it (only with an output directory).
+  std::mutex mutex_;
+  std::condition_variable handed_over_, written_;
+  std::deque<FrameRecord> unwritten_;
+  bool closing_ = false;
+  std::exception_ptr write_error_;
+  std::thread writer_;
 };
 
 }  // namespace snag::report

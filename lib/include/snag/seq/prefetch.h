@@ -27,7 +27,9 @@ struct PrefetchedFrame {
 
 class FramePrefetcher {
  public:
-  using Reader = std::function<mesh::Mesh(const Frame&)>;
+  /// Reads one frame; `reader` (0 .. readers - 1) says which thread calls, so that each can
+  /// keep state of its own (an io::FrameReader).
+  using Reader = std::function<mesh::Mesh(const Frame&, int reader)>;
 
   /// Starts `readers` threads (>= 1) reading `frames` in order with `read`, keeping at most
   /// `depth` (>= 1) frames ahead of the consumer.
@@ -50,7 +52,7 @@ class FramePrefetcher {
     PrefetchedFrame frame;
     std::exception_ptr error;
   };
-  void read_loop();
+  void read_loop(int reader);
 
   std::vector<Frame> frames_;
   Reader read_;

@@ -1,0 +1,43 @@
+// The frame loop of `snag check`, shared with `snag bench io` so that the benchmark times what
+// users run: frames read ahead on reader threads, checked in order, each record handed on as
+// soon as its frame is checked.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "snag/detect/checker.h"
+#include "snag/report/report.h"
+#include "snag/seq/sequence.h"
+
+namespace snag::cli {
+
+struct SequenceSettings {
+  std::optional<double> weld;  ///< --weld: vertices closer than this count as one for adjacency
+  int threads = 1;             ///< the checker's worker threads (readers come on top)
+  bool gpu = false;            ///< the checker runs on a GPU (see readers_for)
+};
+
+/// Reader threads for a run with `threads` workers. On the CPU the checker's threads do the
+/// heavy work and a quarter as many readers keep ahead of them (at least 1, at most 4); on a
+/// GPU the host mostly waits, reading is the work, and every thread but the checker's reads.
+/// Readers wait whenever the frames ahead fill their ring (readers + 2 frames).
+int readers_for(int threads, bool gpu);
+
+/// Reads `frames` ahead and checks them in order with `checker`:
+///  - the topology comes from the first frame; later frames must have its vertex count, and a
+///    different face list is a topology change (a new tree, record.topology_changed);
+///  - with a weld, each topology's first frame decides which vertices count as one;
+///  - on a GPU, each next frame is staged while the current one is checked.
+/// Each frame's record goes to `on_frame` as soon as it is checked; `warn` gets warnings (a
+/// first frame with coincident vertices and no weld). Fills inputs.ids, coincident_vertices
+/// and welded_vertices. Throws snag::InputError for a bad frame at its turn, after every frame
+/// before it was handed on.
+void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker,
+                    const SequenceSettings& settings, report::Inputs& inputs,
+                    const std::function<void(report::FrameRecord&&)>& on_frame,
+                    const std::function<void(const std::string&)>& warn);
+
+}  // namespace snag::cli
