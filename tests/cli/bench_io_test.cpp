@@ -1,0 +1,61 @@
+// `snag bench io` end to end on a small generated cloth: every table is printed, every reader
+// reads every case it can at a positive rate, and the whole-sequence run found the same pairs
+// as checking from memory (the bench fails otherwise).
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli/run_snag.h"
+
+namespace snag::test {
+namespace {
+
+/// The whitespace-separated words of the line of `text` that starts with `prefix`.
+std::vector<std::string> row(const std::string& text, const std::string& prefix) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    std::istringstream in(line.substr(prefix.size()));
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    return words;
+  }
+  ADD_FAILURE() << "no line starting '" << prefix << "' in:\n" << text;
+  return {};
+}
+
+TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
+  TempDir tmp;
+  const std::filesystem::path no_data = tmp.path() / "no-data";
+  std::filesystem::create_directories(no_data);
+  ::setenv("SNAG_DATA_DIR", no_data.c_str(), 1);  // the cloth-ball case is left out
+  const RunResult r = run_snag({"bench", "io", "--size", "800", "--frames", "8", "--passes", "1",
+                                "--memory-frames", "2,8", "--threads", "2"},
+                               tmp.path());
+  ::unsetenv("SNAG_DATA_DIR");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* format : {"OBJ", "PLY binary", "PLY ascii"}) {
+    const std::vector<std::string> rates = row(r.out, std::string("cloth 800 ") + format);
+    ASSERT_EQ(rates.size(), 7u) << format;  // frames, MB/frame, then five readers
+    EXPECT_EQ(rates[0], "8") << format;
+    for (size_t i = 2; i < rates.size(); ++i) {
+      if (rates[i] == "-") {
+        EXPECT_NE(std::string(format), "OBJ");  // only tinyobjloader skips, and only PLY
+        continue;
+      }
+      EXPECT_GT(std::stod(rates[i]), 0) << format << " reader " << i - 2;
+    }
+  }
+  const std::vector<std::string> cpu = row(r.out, "cpu ");
+  ASSERT_EQ(cpu.size(), 8u);
+  EXPECT_EQ(cpu[0], "1");  // readers: a quarter of 2 threads, at least one
+  EXPECT_GT(std::stod(cpu[3]), 0);  // snag check, seconds
+  for (const char* frames : {"       2 ", "       8 "})
+    EXPECT_EQ(row(r.out, frames).size(), 3u) << frames;
+}
+
+}  // namespace
+}  // namespace snag::test
