@@ -224,6 +224,7 @@ TEST(CliStatus, HelpAndVersionExitZero) {
                                                {"check", "--help"},
                                                {"bench", "cpu", "--help"},
                                                {"bench", "gpu", "--help"},
+                                               {"bench", "io", "--help"},
                                                {"--version"}}) {
     const RunResult r = run_snag(args, tmp.path());
     EXPECT_EQ(r.status, 0) << args[0] << "\n" << context(r);
@@ -318,6 +319,7 @@ TEST(CliHelp, AgreesWithTheManPage) {
       {"snag bench cpu", {"bench", "cpu", "--help"}},
       {"snag bench gpu", {"bench", "gpu", "--help"}},
       {"snag bench accuracy", {"bench", "accuracy", "--help"}},
+      {"snag bench io", {"bench", "io", "--help"}},
   };
   for (const auto& [heading, args] : commands) {
     const std::string section = man_section(man, heading);
