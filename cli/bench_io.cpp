@@ -11,9 +11,6 @@
 #include <assimp/scene.h>
 #include <fcntl.h>
 #include <omp.h>
-#include <spawn.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <assimp/Importer.hpp>
 
@@ -45,8 +42,6 @@
 #include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
 #include "snag/validators/exact_modes.h"
-
-extern char** environ;
 
 namespace snag::cli {
 
@@ -371,37 +366,26 @@ std::pair<double, double> peak_memory_of_check(const std::string& pattern, int f
   std::error_code ec;
   const std::string self = fs::read_symlink("/proc/self/exe", ec).string();
   if (ec) throw InternalError("cannot find this executable to run `snag check`");
-  std::vector<std::string> args = {self,
-                                   "check",
-                                   pattern,
-                                   "--frames",
-                                   "1-" + std::to_string(frames),
-                                   "--backend",
-                                   backend,
-                                   "--threads",
-                                   std::to_string(threads),
-                                   "--fail-on",
-                                   "none",
-                                   "--quiet",
-                                   "--out",
-                                   out.string()};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
+  const std::vector<std::string> args = {self,
+                                         "check",
+                                         pattern,
+                                         "--frames",
+                                         "1-" + std::to_string(frames),
+                                         "--backend",
+                                         backend,
+                                         "--threads",
+                                         std::to_string(threads),
+                                         "--fail-on",
+                                         "none",
+                                         "--quiet",
+                                         "--out",
+                                         out.string()};
   const auto started = Clock::now();
-  const int spawned = posix_spawn(&pid, self.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0)
-    throw InternalError("cannot run `snag check`: " + std::string(strerror(spawned)));
-  int status = 0;
-  struct rusage usage {};
-  if (::wait4(pid, &status, 0, &usage) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) > 1)
+  const ChildRun run = run_quietly(args);
+  if (!run.started) throw InternalError("cannot run `snag check` (" + self + ")");
+  if (run.exit_status < 0 || run.exit_status > 1)
     throw InternalError("`snag check` on " + std::to_string(frames) + " frames failed");
-  return {static_cast<double>(usage.ru_maxrss) / 1024.0, seconds_since(started)};
+  return {run.peak_mib, seconds_since(started)};
 }
 
 void memory_table(const std::string& name, const std::string& pattern,

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -52,28 +53,27 @@ std::string find_generator(const std::string& given) {
   return "snag-cloth";
 }
 
-namespace {
-
-void run_program(const std::vector<std::string>& args) {
+ChildRun run_quietly(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
-  // The generator's own summary would break up the table: its standard output goes nowhere.
+  // A child's own summary would break up the table: its standard output goes nowhere.
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   pid_t pid = 0;
   const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0)
-    throw UsageError("cannot run the sample generator '" + args[0] +
-                     "' (build it, or give its path with --generator)");
+  ChildRun run;
+  if (spawned != 0) return run;
+  run.started = true;
   int status = 0;
-  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw InternalError("the sample generator '" + args[0] + "' failed");
+  struct rusage usage {};
+  if (::wait4(pid, &status, 0, &usage) < 0) return run;
+  if (WIFEXITED(status)) run.exit_status = WEXITSTATUS(status);
+  run.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
+  return run;
 }
-
-}  // namespace
 
 std::vector<fs::path> generated_cloth(const std::string& generator, int triangles, int settle,
                                       int keep, const fs::path& dir) {
@@ -81,9 +81,14 @@ std::vector<fs::path> generated_cloth(const std::string& generator, int triangle
   const int total = settle + keep;
   std::cerr << "snag bench: generating cloth, about " << triangles << " triangles, " << total
             << " frames\n";
-  run_program({find_generator(generator), "--triangles", std::to_string(triangles), "--frames",
-               std::to_string(total), "--output-dir", dir.string(), "--prefix", "cloth",
-               "--quiet"});
+  const std::string program = find_generator(generator);
+  const ChildRun run = run_quietly({program, "--triangles", std::to_string(triangles), "--frames",
+                                    std::to_string(total), "--output-dir", dir.string(), "--prefix",
+                                    "cloth", "--quiet"});
+  if (!run.started)
+    throw UsageError("cannot run the sample generator '" + program +
+                     "' (build it, or give its path with --generator)");
+  if (run.exit_status != 0) throw InternalError("the sample generator '" + program + "' failed");
   std::vector<fs::path> files;
   for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
   if (files.size() > static_cast<size_t>(keep)) files.erase(files.begin(), files.end() - keep);

@@ -36,6 +36,17 @@ class ScratchDir {
 /// layout), else in the build tree's samples/ (build layout), else `snag-cloth` on PATH.
 std::string find_generator(const std::string& given);
 
+/// How a child program ended.
+struct ChildRun {
+  bool started = false;  ///< false when it could not be run at all
+  int exit_status = -1;  ///< -1 when it did not exit normally (a signal)
+  double peak_mib = 0;   ///< its peak resident memory
+};
+
+/// Runs `args` (args[0] found on PATH when it has no '/') with its standard output thrown
+/// away, and waits for it.
+ChildRun run_quietly(const std::vector<std::string>& args);
+
 /// Generates a cloth of about `triangles` triangles into `dir` with `settle` + `keep` frames and
 /// returns the last `keep` frame files.
 std::vector<std::filesystem::path> generated_cloth(const std::string& generator, int triangles,
@@ -64,11 +75,11 @@ void add_data_case(std::vector<BenchCase>& cases, const std::filesystem::path& d
 
 /// Where a benchmark's cases come from, as every `snag bench` command takes them.
 struct CaseOptions {
-  std::vector<int>* sizes;          ///< --sizes: generated cloth sizes
-  std::string* data_dir;            ///< --data
+  std::vector<int>* sizes;           ///< --sizes: generated cloth sizes
+  std::string* data_dir;             ///< --data
   std::vector<std::string>* inputs;  ///< --input, repeatable
-  std::string* generator;           ///< --generator
-  int* threads;                     ///< -j, --threads
+  std::string* generator;            ///< --generator
+  int* threads;                      ///< -j, --threads
 };
 
 /// Adds --sizes, --data, --input, --generator and -j/--threads to `cmd`. `data_cases` says what
