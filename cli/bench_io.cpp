@@ -449,20 +449,8 @@ CLI::App* add_bench_io_command(CLI::App& bench, BenchIoOptions& o) {
       ->delimiter(',')
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  io->add_option("--data", o.data_dir,
-                 "The shared data folder; its cloth-ball frames (big-endian PLY) are a reader "
-                 "case when present (default: $SNAG_DATA_DIR, else the one known at build time)")
-      ->type_name("DIR");
-  io->add_option("--input", o.inputs, "Also read this sequence (repeatable)")
-      ->type_name("SEQUENCE");
-  io->add_option("--generator", o.generator,
-                 "The snag-cloth sample generator (default: beside snag, in the build tree, or "
-                 "on PATH)")
-      ->type_name("PATH");
-  io->add_option("-j,--threads", o.threads, "Threads in all; 0 uses every core")
-      ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_case_options(io, {nullptr, &o.data_dir, &o.inputs, &o.generator, &o.threads},
+                   "its cloth-ball frames (big-endian PLY) are a reader case", "read");
   io->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)

@@ -147,12 +147,13 @@ CaseFrames read_case(const BenchCase& c, std::string_view command) {
 
 void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& data_cases,
                       const std::string& verb) {
-  cmd->add_option("--sizes", *o.sizes,
-                  "Generated cloth sizes in triangles (0 or an empty list: none)")
-      ->type_name("T,...")
-      ->delimiter(',')
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  if (o.sizes)
+    cmd->add_option("--sizes", *o.sizes,
+                    "Generated cloth sizes in triangles (0 or an empty list: none)")
+        ->type_name("T,...")
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
   cmd->add_option("--data", *o.data_dir,
                   "The shared data folder; " + data_cases +
                       " when present (default: $SNAG_DATA_DIR, else the one known at build time)")

@@ -82,8 +82,9 @@ struct CaseOptions {
   int* threads;                      ///< -j, --threads
 };
 
-/// Adds --sizes, --data, --input, --generator and -j/--threads to `cmd`. `data_cases` says what
-/// the data folder contributes ("its cloth-ball frames are a case"); `verb` what is done to an
+/// Adds --sizes (when wanted), --data, --input, --generator and -j/--threads to `cmd`. `data_cases`
+/// says what the data folder contributes ("its cloth-ball frames are a case"); `verb` what is done
+/// to an
 /// --input sequence ("time", "score").
 void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& data_cases,
                       const std::string& verb);
