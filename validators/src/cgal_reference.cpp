@@ -2,10 +2,10 @@
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/box_intersection_d.h>
+#include <CGAL/intersections.h>
 
 #include <algorithm>
 #include <string>
@@ -34,6 +34,34 @@ void sort_pairs(std::vector<std::pair<int32_t, int32_t>>& pairs) {
     if (a > b) std::swap(a, b);
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+}
+
+using Box =
+    CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t,
+                                              CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
+
+/// The boxes of the triangles that are not zero-area, each carrying its triangle's id.
+std::vector<Box> boxes_of(std::span<const geom::Vec3d> positions,
+                          std::span<const geom::Tri> triangles) {
+  std::vector<Box> boxes;
+  boxes.reserve(triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const geom::Tri& tri = triangles[t];
+    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] ||
+        degenerate(positions, tri))
+      continue;
+    const auto box = point_of(positions[tri.v[0]]).bbox() + point_of(positions[tri.v[1]]).bbox() +
+                     point_of(positions[tri.v[2]]).bbox();
+    boxes.emplace_back(box, static_cast<int32_t>(t));
+  }
+  return boxes;
+}
+
+std::vector<const Box*> pointers_to(const std::vector<Box>& boxes) {
+  std::vector<const Box*> pointers;
+  pointers.reserve(boxes.size());
+  for (const Box& b : boxes) pointers.push_back(&b);
+  return pointers;
 }
 
 }  // namespace
@@ -159,21 +187,8 @@ std::vector<std::pair<int32_t, int32_t>> cgal_self_intersections(
 
 std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
     std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles) {
-  using Box =
-      CGAL::Box_intersection_d::Box_with_info_d<double, 3, int32_t,
-                                                CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
-  std::vector<Box> boxes;
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    const geom::Tri& tri = triangles[t];
-    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0] ||
-        degenerate(positions, tri))
-      continue;
-    const auto box = point_of(positions[tri.v[0]]).bbox() + point_of(positions[tri.v[1]]).bbox() +
-                     point_of(positions[tri.v[2]]).bbox();
-    boxes.emplace_back(box, static_cast<int32_t>(t));
-  }
-  std::vector<const Box*> pointers;
-  for (const Box& b : boxes) pointers.push_back(&b);
+  const std::vector<Box> boxes = boxes_of(positions, triangles);
+  std::vector<const Box*> pointers = pointers_to(boxes);
   std::vector<std::pair<int32_t, int32_t>> pairs;
   CGAL::box_self_intersection_d<CGAL::Sequential_tag>(
       pointers.begin(), pointers.end(), [&](const Box* a, const Box* b) {
@@ -181,6 +196,32 @@ std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
           pairs.emplace_back(a->info(), b->info());
       });
   sort_pairs(pairs);
+  return pairs;
+}
+
+std::vector<std::pair<int32_t, int32_t>> cgal_pairs_between(
+    std::span<const geom::Vec3d> positions_a, std::span<const geom::Tri> triangles_a,
+    std::span<const geom::Vec3d> positions_b, std::span<const geom::Tri> triangles_b) {
+  const std::vector<Box> boxes_a = boxes_of(positions_a, triangles_a);
+  const std::vector<Box> boxes_b = boxes_of(positions_b, triangles_b);
+  std::vector<const Box*> pointers_a = pointers_to(boxes_a), pointers_b = pointers_to(boxes_b);
+  auto triangle = [](std::span<const geom::Vec3d> positions, const geom::Tri& t) {
+    return Kernel::Triangle_3(point_of(positions[t.v[0]]), point_of(positions[t.v[1]]),
+                              point_of(positions[t.v[2]]));
+  };
+  std::vector<std::pair<int32_t, int32_t>> pairs;
+  // The bipartite form calls back with a box of the first sequence first. The meshes share no
+  // vertex, so any common point counts: plain do_intersect, no shared-vertex rules.
+  CGAL::box_intersection_d<CGAL::Sequential_tag>(
+      pointers_a.begin(), pointers_a.end(), pointers_b.begin(), pointers_b.end(),
+      [&](const Box* a, const Box* b) {
+        if (CGAL::do_intersect(triangle(positions_a, triangles_a[a->info()]),
+                               triangle(positions_b, triangles_b[b->info()])))
+          pairs.emplace_back(a->info(), b->info());
+      });
+  // Not sort_pairs: (i, j) index two different meshes, so i > j must not be swapped.
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
 }
 

@@ -50,6 +50,16 @@ class CgalSequence {
 std::vector<std::pair<int32_t, int32_t>> cgal_soup_self_intersections(
     std::span<const geom::Vec3d> positions, std::span<const geom::Tri> triangles);
 
+/// Pairs between two separate meshes A and B (a cloth and an obstacle), which share no
+/// topology: every (i, j), i a triangle of A (indices into positions_a) and j one of B (into
+/// positions_b), whose closed triangles share a point, decided by CGAL::do_intersect (exact
+/// for the predicate) on candidates from CGAL's bipartite box intersection (closed boxes, so
+/// exact contacts are candidates). Zero-area triangles of either mesh are left out (snag
+/// reports them apart). Sorted by (i, j), no duplicates.
+std::vector<std::pair<int32_t, int32_t>> cgal_pairs_between(
+    std::span<const geom::Vec3d> positions_a, std::span<const geom::Tri> triangles_a,
+    std::span<const geom::Vec3d> positions_b, std::span<const geom::Tri> triangles_b);
+
 /// snag's pairs as CGAL's answers above give them: (a, b) ids, in the same order.
 std::vector<std::pair<int32_t, int32_t>> pair_ids(std::span<const detect::FacePair> pairs);
 
