@@ -398,6 +398,110 @@ TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
   }
 }
 
+/// A scene's objects whose names need CSV quoting, JSON escapes or hold UTF-8.
+std::vector<ObjectInput> scene_objects() {
+  return {{"dress", "cloth", "cache/dress.%04d.obj", std::nullopt, false, 1e-6, 300, 500, ""},
+          {"a,b", "cloth", "cache/dress.%04d.obj", "sleeve", false, std::nullopt, 40, 60, ""},
+          {"say \"hi\"", "obstacle", "cache/body.%04d.obj", std::nullopt, false, std::nullopt, 900,
+           1800, "closed"},
+          {"dr\xc3\xa9pe\nfloor", "obstacle", "floor.obj", std::nullopt, true, 0.5, 4, 2,
+           "edge (0, 1) is used by 1 triangle (a hole)"}};
+}
+
+/// random_frames(seed, count) made scene frames of `objects`: every pair and degenerate face
+/// given objects (pairs with object_a <= object_b), one object record per object, random
+/// checks (some reused) and up to two penetration entries with random depths.
+std::vector<FrameRecord> random_scene_frames(uint32_t seed, int count,
+                                             const std::vector<ObjectInput>& objects) {
+  std::vector<FrameRecord> frames = random_frames(seed, count);
+  std::mt19937 rng(seed + 1000);
+  const int last = static_cast<int>(objects.size()) - 1;
+  const auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); };
+  const auto real = [&](double hi) { return std::uniform_real_distribution<double>(0, hi)(rng); };
+  for (FrameRecord& f : frames) {
+    for (Pair& p : f.pairs) {
+      p.object_a = uniform(0, last);
+      p.object_b = uniform(p.object_a, last);
+    }
+    for (Face& d : f.degenerate) d.object = uniform(0, last);
+    for (const ObjectInput& o : objects)
+      f.objects.push_back({o.sequence + "." + std::to_string(f.frame), uniform(0, 3) > 0,
+                           uniform(0, 5) == 0, real(0.01), real(0.01), 1 + real(3)});
+    for (int c = uniform(0, 4); c > 0; --c) {
+      const int a = uniform(0, last);
+      f.checks.push_back({a, uniform(a, last), uniform(0, 500), uniform(0, 2) == 0, real(0.01)});
+    }
+    for (int e = uniform(0, 2); e > 0; --e) {
+      Penetration pen{uniform(0, last), uniform(0, last), uniform(1, 5000), 0, 0, 0, 0, 0};
+      pen.inside = uniform(0, 2) == 0 ? 0 : uniform(1, static_cast<int>(pen.vertices));
+      pen.ratio = static_cast<double>(pen.inside) / static_cast<double>(pen.vertices);
+      if (pen.inside > 0) {
+        pen.max_depth = real(0.05);
+        pen.mean_depth = pen.max_depth * real(1);
+        pen.p95_depth = pen.max_depth * real(1);
+      }
+      f.penetration.push_back(pen);
+    }
+  }
+  return frames;
+}
+
+TEST(ReportStream, SceneRunMatchesTheWholeReportWriters) {
+  for (uint32_t seed : {4u, 5u, 6u}) {
+    SCOPED_TRACE("seed=" + std::to_string(seed));
+    Settings settings = small_settings();
+    settings.fail_on = seed == 5 ? FailOn::crossing : FailOn::any;
+    Inputs inputs = small_inputs();
+    inputs.sequence = "cache/scene.json";
+    inputs.objects = scene_objects();
+    const std::vector<FrameRecord> frames = random_scene_frames(seed, 40, inputs.objects);
+
+    TempDir tmp;
+    ReportStream stream(tmp.path(), "0.1.0", settings, inputs.objects);
+    for (const FrameRecord& f : frames) stream.add(f);
+    const Summary streamed = stream.finish(inputs, 5, 1, 3.75);
+
+    const Report r = whole_report("0.1.0", settings, inputs, frames, 5, 1, 3.75);
+    std::ostringstream pairs, frames_csv;
+    write_pairs_csv(pairs, r);
+    write_frames_csv(frames_csv, r);
+    const std::string streamed_pairs = read_all(tmp.path() / "pairs.csv");
+    EXPECT_EQ(streamed_pairs, pairs.str());
+    EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
+    EXPECT_EQ(streamed_pairs.substr(0, streamed_pairs.find('\n')), scene_pairs_csv_header);
+    const std::string json = read_all(tmp.path() / "report.json");
+    EXPECT_EQ(json, report_json(r));
+    EXPECT_TRUE(is_whole_document_dump(json));
+    EXPECT_TRUE(streamed == summarize(r));
+    const auto parsed = nlohmann::json::parse(json);
+    EXPECT_EQ(parsed.at("inputs").at("objects").size(), 4u);
+    EXPECT_EQ(parsed.at("inputs").at("objects").at(3).at("name"), "dr\xc3\xa9pe\nfloor");
+    EXPECT_EQ(parsed.at("summary").at("reused_pairs"), streamed.reused_pairs);
+
+    // write_reports (a stream fed the Report) gives the same three files.
+    TempDir whole;
+    write_reports(whole.path(), r);
+    for (const char* name : {"pairs.csv", "frames.csv", "report.json"})
+      EXPECT_EQ(read_all(whole.path() / name), read_all(tmp.path() / name)) << name;
+  }
+}
+
+TEST(ReportStream, SceneRunWithoutFramesHasSceneHeadersAndKeys) {
+  TempDir tmp;
+  Inputs inputs = small_inputs();
+  inputs.objects = scene_objects();
+  ReportStream stream(tmp.path(), "1.2.3", small_settings(), inputs.objects);
+  stream.finish(inputs, 0, 0, 0.25);
+  EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), std::string(scene_pairs_csv_header) + "\n");
+  EXPECT_EQ(read_all(tmp.path() / "frames.csv"), std::string(scene_frames_csv_header) + "\n");
+  const std::string json = read_all(tmp.path() / "report.json");
+  EXPECT_TRUE(is_whole_document_dump(json)) << json;
+  EXPECT_EQ(json, report_json(whole_report("1.2.3", small_settings(), inputs, {}, 0, 0, 0.25)));
+  const auto j = nlohmann::json::parse(json);
+  EXPECT_EQ(j.at("summary").at("reused_pairs"), 0);
+  EXPECT_EQ(j.at("summary").at("max_depth"), 0.0);
+}
+
 TEST(ReportStream, WrittenProgressivelyIntoHiddenTemporaries) {
   TempDir tmp;
   ReportStream stream(tmp.path(), "1.2.3", small_settings());
@@ -438,6 +542,37 @@ TEST(ReportStream, ExceptionMidRunLeavesNoFileAndKeepsTheEarlierRun) {
     throw std::runtime_error("frame 5: malformed");
   };
   EXPECT_THROW(run_failing_at_the_third_frame(), std::runtime_error);
+  expect_earlier_run(tmp.path());
+}
+
+TEST(ReportStream, SceneObjectsMustMatchAtFinish) {
+  TempDir tmp;
+  write_earlier_run(tmp.path());
+  Inputs inputs = small_inputs();
+  inputs.objects = scene_objects();
+  const std::vector<FrameRecord> frames = random_scene_frames(7, 3, inputs.objects);
+  {
+    ReportStream stream(tmp.path(), "1.2.3", small_settings(), inputs.objects);
+    for (const FrameRecord& f : frames) stream.add(f);
+    Inputs renamed = inputs;
+    renamed.objects[1].name = "sleeve";
+    EXPECT_THROW(stream.finish(renamed, 1, 0, 1.0), InternalError);
+  }
+  expect_earlier_run(tmp.path());
+  {
+    // A single-mesh stream finished with objects, the other way round.
+    ReportStream stream(tmp.path(), "1.2.3", small_settings());
+    EXPECT_THROW(stream.finish(inputs, 1, 0, 1.0), InternalError);
+  }
+  expect_earlier_run(tmp.path());
+  {
+    // A frame naming an object the stream does not have fails the run.
+    ReportStream stream(tmp.path(), "1.2.3", small_settings(), inputs.objects);
+    FrameRecord bad = frames[0];
+    bad.pairs.push_back({0, 1, PairKind::crossing, 0, 1, 0, 4});
+    stream.add(bad);
+    EXPECT_THROW(stream.finish(inputs, 1, 0, 1.0), InternalError);
+  }
   expect_earlier_run(tmp.path());
 }
 
@@ -530,8 +665,8 @@ TEST(ReportStream, WithoutDirectoryKeepsTheSummaryOnly) {
 void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n, FailOn fail_on,
                                 const Summary& s) {
   int64_t with_crossings = 0, with_pairs = 0, pairs = 0, crossing = 0, degenerate = 0;
-  int64_t uncertain = 0, confirmed = 0, topology = 0;
-  double check = 0, read = 0;
+  int64_t uncertain = 0, confirmed = 0, topology = 0, reused = 0;
+  double check = 0, read = 0, max_depth = 0;
   std::optional<size_t> worst;
   std::tuple<int64_t, int64_t, int64_t> worst_key{-1, -1, 0};
   for (size_t i = 0; i < n; ++i) {
@@ -547,6 +682,8 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
     uncertain += f.uncertain_tests;
     confirmed += f.confirmed_pairs;
     topology += f.topology_changed ? 1 : 0;
+    for (const CheckFrame& c : f.checks) reused += c.reused ? c.pairs : 0;
+    for (const Penetration& p : f.penetration) max_depth = std::max(max_depth, p.max_depth);
     check += f.times.total();
     read += f.read_seconds;
     const std::tuple<int64_t, int64_t, int64_t> key{frame_crossing, frame_pairs,
@@ -566,6 +703,8 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
   EXPECT_EQ(s.uncertain_tests, uncertain);
   EXPECT_EQ(s.confirmed_pairs, confirmed);
   EXPECT_EQ(s.topology_changes, topology);
+  EXPECT_EQ(s.reused_pairs, reused);
+  EXPECT_EQ(s.max_depth, max_depth);
   EXPECT_DOUBLE_EQ(s.check_seconds, check);
   EXPECT_DOUBLE_EQ(s.read_seconds, read);
   EXPECT_EQ(s.worst_frame, worst);
@@ -586,7 +725,9 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
 TEST(SummaryAccumulator, MatchesABruteForceRecountAfterEveryFrame) {
   for (uint32_t seed : {11u, 12u, 13u, 14u}) {
     SCOPED_TRACE("seed=" + std::to_string(seed));
-    std::vector<FrameRecord> frames = random_frames(seed, 80);
+    // Odd seeds: scene frames, with reused checks and penetration depths.
+    std::vector<FrameRecord> frames =
+        seed % 2 ? random_scene_frames(seed, 80, scene_objects()) : random_frames(seed, 80);
     // Ties for the worst frame: the same counts again later must not take its place.
     frames[40].pairs = frames[20].pairs;
     frames[41].pairs = frames[20].pairs;

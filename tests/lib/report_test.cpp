@@ -269,6 +269,271 @@ TEST(ReportJson, NullsForAbsentSettingsAndWorstFrame) {
   EXPECT_EQ(j.at("summary").at("failed"), false);
 }
 
+/// A scene run of three objects: a cloth, a body whose name needs CSV quoting (closed, so its
+/// penetration is measured) and a still floor with a hole. Frame 7 has a self pair of the
+/// dress, pairs against both obstacles (listed out of pair_order, one with face_a > face_b
+/// across objects), a degenerate face of the body and a reused check; frame 8 is clean and
+/// has no penetration entry. Every time and depth is a sum of powers of two.
+Report scene_report() {
+  Report r;
+  r.snag_version = "9.9.9";
+  r.settings.backend = "cpu";
+  r.settings.backend_requested = "cpu";
+  r.settings.threads = 2;
+  r.settings.exact = "uncertain";
+  r.settings.exact_predicates = "cgal";
+  r.settings.rebuild = "auto";
+  r.settings.rebuild_threshold = 1.5;
+  r.inputs.sequence = "shots/scene.json";
+  ObjectInput dress{"dress", "cloth", "shots/dress.%04d.obj", std::nullopt, false, 1e-6, 8, 5, ""};
+  ObjectInput body{
+      "body, left", "obstacle", "shots/body.%04d.obj", "torso", false, std::nullopt, 6, 8,
+      "closed"};
+  ObjectInput floor{"floor", "obstacle", "floor.obj", std::nullopt, true, std::nullopt, 4, 2, ""};
+  floor.closed = "edge (0, 1) is used by 1 triangle (a hole)";
+  r.inputs.objects = {dress, body, floor};
+
+  FrameRecord f7;
+  f7.frame = 7;
+  f7.file = "shots/dress.0007.obj";
+  f7.vertices = 18;
+  f7.triangles = 15;
+  f7.polygons = 14;
+  f7.pairs = {{2, 5, PairKind::crossing, 2, 5, 0, 1},
+              {0, 3, PairKind::touching, 0, 2, 0, 0},
+              {4, 1, PairKind::touching, 3, 1, 0, 1},
+              {0, 1, PairKind::crossing, 0, 0, 0, 2}};
+  f7.degenerate = {{1, 1, 1}};
+  f7.candidate_pairs = 11;
+  f7.filtered_tests = 20;
+  f7.rebuilt = true;
+  f7.tree_quality = 2.5;
+  f7.times.build = 0.5;
+  f7.times.traverse = 0.25;
+  f7.times.classify = 0.125;
+  f7.read_seconds = 0.0625;
+  f7.objects = {{"shots/dress.0007.obj", true, true, 0.5, 0, 2.5},
+                {"shots/body.0007.obj", true, false, 0, 0.25, 1.5},
+                {"floor.obj", false, false, 0, 0, 1.0}};
+  f7.checks = {{0, 0, 1, false, 0.125}, {0, 1, 2, false, 0.25}, {0, 2, 1, true, 0}};
+  f7.penetration = {{0, 1, 8, 3, 0.375, 0.015625, 0.0078125, 0.015625}};
+
+  FrameRecord f8;
+  f8.frame = 8;
+  f8.file = "shots/dress.0008.obj";
+  f8.vertices = 18;
+  f8.triangles = 15;
+  f8.polygons = 14;
+  f8.candidate_pairs = 4;
+  f8.filtered_tests = 4;
+  f8.tree_quality = 2.5;
+  f8.times.refit = 0.25;
+  f8.times.traverse = 0.125;
+  f8.objects = {{"shots/dress.0008.obj", true, false, 0, 0.25, 2.5},
+                {"shots/body.0007.obj", false, false, 0, 0, 1.5},
+                {"floor.obj", false, false, 0, 0, 1.0}};
+  f8.checks = {{0, 0, 0, false, 0.0625}, {0, 1, 0, true, 0}, {0, 2, 0, true, 0}};
+
+  r.frames = {std::move(f7), std::move(f8)};
+  r.builds = 3;
+  r.wall_seconds = 1.5;
+  return r;
+}
+
+TEST(ReportScene, FrameTotalsAndSummary) {
+  const Report r = scene_report();
+  const FrameRecord& f7 = r.frames[0];
+  EXPECT_EQ(f7.reused_pairs(), 1);
+  EXPECT_EQ(f7.inside_vertices(), 3);
+  EXPECT_DOUBLE_EQ(f7.max_depth(), 0.015625);
+  EXPECT_EQ(r.frames[1].reused_pairs(), 0);
+  EXPECT_EQ(r.frames[1].inside_vertices(), 0);
+  EXPECT_EQ(r.frames[1].max_depth(), 0.0);
+  const Summary s = summarize(r);
+  EXPECT_EQ(s.pairs, 4);
+  EXPECT_EQ(s.crossing, 2);
+  EXPECT_EQ(s.reused_pairs, 1);
+  EXPECT_DOUBLE_EQ(s.max_depth, 0.015625);
+  // A single-mesh run has neither.
+  const Summary single = summarize(hand_built_report());
+  EXPECT_EQ(single.reused_pairs, 0);
+  EXPECT_EQ(single.max_depth, 0.0);
+}
+
+TEST(ReportScene, PairsCsvBytes) {
+  std::ostringstream out;
+  write_pairs_csv(out, scene_report());
+  EXPECT_EQ(out.str(),
+            "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n"
+            "7,0,3,touching,0,2,dress,dress\n"
+            "7,0,1,crossing,0,0,dress,floor\n"
+            "7,2,5,crossing,2,5,dress,\"body, left\"\n"
+            "7,4,1,touching,3,1,dress,\"body, left\"\n");
+}
+
+TEST(ReportScene, FramesCsvBytes) {
+  std::ostringstream out;
+  write_frames_csv(out, scene_report());
+  EXPECT_EQ(out.str(),
+            "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
+            "topology_changed,reused_pairs,inside_vertices,max_depth\n"
+            "7,shots/dress.0007.obj,15,4,2,2,1,0,0.875000,1,0,1,3,0.015625\n"
+            "8,shots/dress.0008.obj,15,0,0,0,0,0,0.375000,0,0,0,0,0.000000\n");
+}
+
+TEST(ReportScene, RowWritersTakeTheObjectsAndLeaveThemOutWithout) {
+  const Report r = scene_report();
+  const FrameRecord& f7 = r.frames[0];
+  std::ostringstream scene_pairs, scene_frame, single_pairs, single_frame;
+  write_pairs_rows(scene_pairs, f7, r.inputs.objects);
+  write_frames_row(scene_frame, f7, r.inputs.objects);
+  write_pairs_rows(single_pairs, f7);
+  write_frames_row(single_frame, f7);
+  EXPECT_EQ(scene_pairs.str().substr(0, 31), "7,0,3,touching,0,2,dress,dress\n");
+  EXPECT_EQ(scene_frame.str(), "7,shots/dress.0007.obj,15,4,2,2,1,0,0.875000,1,0,1,3,0.015625\n");
+  // Without objects: today's columns (the rows in pair_order all the same).
+  EXPECT_EQ(single_pairs.str(),
+            "7,0,3,touching,0,2\n"
+            "7,0,1,crossing,0,0\n"
+            "7,2,5,crossing,2,5\n"
+            "7,4,1,touching,3,1\n");
+  EXPECT_EQ(single_frame.str(), "7,shots/dress.0007.obj,15,4,2,2,1,0,0.875000,1,0\n");
+  EXPECT_EQ(pairs_csv_header_for(r.inputs.objects), scene_pairs_csv_header);
+  EXPECT_EQ(frames_csv_header_for({}), frames_csv_header);
+}
+
+TEST(ReportScene, JsonParsesBackWithTheSceneKeys) {
+  const std::string text = report_json(scene_report());
+  EXPECT_EQ(nlohmann::ordered_json::parse(text).dump(2) + "\n", text);  // dump(2)'s layout
+  const auto j = nlohmann::json::parse(text);
+  EXPECT_EQ(j.at("schema"), "snag-report/2");
+
+  const auto& objects = j.at("inputs").at("objects");
+  ASSERT_EQ(objects.size(), 3u);
+  EXPECT_EQ(objects.at(0), (nlohmann::json{{"name", "dress"},
+                                           {"role", "cloth"},
+                                           {"sequence", "shots/dress.%04d.obj"},
+                                           {"group", nullptr},
+                                           {"still", false},
+                                           {"weld", 1e-6},
+                                           {"vertices", 8},
+                                           {"triangles", 5},
+                                           {"closed", nullptr}}));
+  EXPECT_EQ(objects.at(1).at("name"), "body, left");
+  EXPECT_EQ(objects.at(1).at("role"), "obstacle");
+  EXPECT_EQ(objects.at(1).at("group"), "torso");
+  EXPECT_TRUE(objects.at(1).at("weld").is_null());
+  EXPECT_EQ(objects.at(1).at("closed"), "closed");
+  EXPECT_EQ(objects.at(2).at("still"), true);
+  EXPECT_EQ(objects.at(2).at("vertices"), 4);
+  EXPECT_EQ(objects.at(2).at("triangles"), 2);
+  EXPECT_EQ(objects.at(2).at("closed"), "edge (0, 1) is used by 1 triangle (a hole)");
+
+  const auto& f7 = j.at("frames").at(0);
+  EXPECT_EQ(f7.at("frame"), 7);
+  const auto& pairs = f7.at("pairs");
+  ASSERT_EQ(pairs.size(), 4u);  // the record's order, as for a single mesh
+  EXPECT_EQ(pairs.at(0), (nlohmann::json{{"a", 2},
+                                         {"b", 5},
+                                         {"kind", "crossing"},
+                                         {"poly_a", 2},
+                                         {"poly_b", 5},
+                                         {"object_a", "dress"},
+                                         {"object_b", "body, left"}}));
+  EXPECT_EQ(pairs.at(1).at("object_b"), "dress");
+  EXPECT_EQ(pairs.at(3).at("object_b"), "floor");
+  EXPECT_EQ(f7.at("degenerate"),
+            (nlohmann::json::array({{{"face", 1}, {"poly", 1}, {"object", "body, left"}}})));
+
+  const auto& per_object = f7.at("objects");
+  ASSERT_EQ(per_object.size(), 3u);
+  EXPECT_EQ(per_object.at(1), (nlohmann::json{{"name", "body, left"},
+                                              {"file", "shots/body.0007.obj"},
+                                              {"moved", true},
+                                              {"rebuilt", false},
+                                              {"build_seconds", 0.0},
+                                              {"refit_seconds", 0.25},
+                                              {"tree_quality", 1.5}}));
+  EXPECT_EQ(per_object.at(0).at("rebuilt"), true);
+  EXPECT_EQ(per_object.at(0).at("build_seconds"), 0.5);
+  EXPECT_EQ(per_object.at(2).at("name"), "floor");
+  EXPECT_EQ(per_object.at(2).at("moved"), false);
+
+  const auto& checks = f7.at("checks");
+  ASSERT_EQ(checks.size(), 3u);
+  EXPECT_EQ(
+      checks.at(0),
+      (nlohmann::json{
+          {"objects", {"dress", "dress"}}, {"pairs", 1}, {"reused", false}, {"seconds", 0.125}}));
+  EXPECT_EQ(checks.at(1).at("objects"), (nlohmann::json{"dress", "body, left"}));
+  EXPECT_EQ(checks.at(1).at("pairs"), 2);
+  EXPECT_EQ(checks.at(2).at("objects"), (nlohmann::json{"dress", "floor"}));
+  EXPECT_EQ(checks.at(2).at("reused"), true);
+
+  EXPECT_EQ(f7.at("penetration"), (nlohmann::json::array({{{"cloth", "dress"},
+                                                           {"obstacle", "body, left"},
+                                                           {"vertices", 8},
+                                                           {"inside", 3},
+                                                           {"ratio", 0.375},
+                                                           {"max_depth", 0.015625},
+                                                           {"mean_depth", 0.0078125},
+                                                           {"p95_depth", 0.015625}}})));
+  const auto& f8 = j.at("frames").at(1);
+  EXPECT_TRUE(f8.at("pairs").empty());
+  EXPECT_TRUE(f8.at("penetration").empty());
+  EXPECT_EQ(f8.at("objects").size(), 3u);
+
+  const auto& s = j.at("summary");
+  EXPECT_EQ(s.at("reused_pairs"), 1);
+  EXPECT_EQ(s.at("max_depth"), 0.015625);
+  EXPECT_EQ(s.at("pairs"), 4);
+  EXPECT_EQ(s.at("builds"), 3);
+}
+
+TEST(ReportScene, SingleMeshJsonHasNoSceneKeys) {
+  const auto j = nlohmann::json::parse(report_json(hand_built_report()));
+  EXPECT_FALSE(j.at("inputs").contains("objects"));
+  for (const auto& frame : j.at("frames")) {
+    for (const char* key : {"objects", "checks", "penetration"})
+      EXPECT_FALSE(frame.contains(key)) << key;
+    for (const auto& pair : frame.at("pairs")) EXPECT_FALSE(pair.contains("object_a"));
+    for (const auto& face : frame.at("degenerate")) EXPECT_FALSE(face.contains("object"));
+  }
+  EXPECT_FALSE(j.at("summary").contains("reused_pairs"));
+  EXPECT_FALSE(j.at("summary").contains("max_depth"));
+}
+
+TEST(ReportScene, UnknownObjectsAreInternalErrors) {
+  const Report good = scene_report();
+  const auto all_writers_throw = [](const Report& r) {
+    EXPECT_THROW(report_json(r), InternalError);
+    TempDir tmp;
+    EXPECT_THROW(write_reports(tmp.path(), r), InternalError);
+    EXPECT_TRUE(entries(tmp.path()).empty());
+  };
+  Report r = good;
+  r.frames[0].pairs[2].object_b = 3;
+  all_writers_throw(r);
+  std::ostringstream sink;
+  EXPECT_THROW(write_pairs_csv(sink, r), InternalError);
+
+  r = good;
+  r.frames[0].degenerate[0].object = -1;
+  all_writers_throw(r);
+
+  r = good;
+  r.frames[1].objects.pop_back();  // not one per object
+  all_writers_throw(r);
+
+  r = good;
+  r.frames[0].checks[1].object_b = 5;
+  all_writers_throw(r);
+
+  r = good;
+  r.frames[0].penetration[0].obstacle = 3;
+  all_writers_throw(r);
+}
+
 TEST(ReportWrite, WritesTheThreeFilesAndNothingElse) {
   TempDir tmp;
   const fs::path out = tmp.path() / "nested" / "report";

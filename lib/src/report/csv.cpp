@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "snag/error.h"
+
 namespace snag::report {
 
 namespace {
@@ -36,12 +38,35 @@ std::string csv_field(std::string_view field) {
   return quoted;
 }
 
-void write_pairs_rows(std::ostream& out, const FrameRecord& f) {
+std::string_view pairs_csv_header_for(std::span<const ObjectInput> objects) {
+  return objects.empty() ? pairs_csv_header : scene_pairs_csv_header;
+}
+
+std::string_view frames_csv_header_for(std::span<const ObjectInput> objects) {
+  return objects.empty() ? frames_csv_header : scene_frames_csv_header;
+}
+
+void write_pairs_rows(std::ostream& out, const FrameRecord& f,
+                      std::span<const ObjectInput> objects) {
   // std::to_chars into a line buffer: a 100K-pair frame is written in milliseconds, and the
   // bytes do not depend on the stream's locale or flags.
   char line[128];
   char* const after_frame = std::to_chars(line, line + 24, f.frame).ptr;
   *after_frame = ',';
+  // A scene run's rows end in two names of any length: the numbers are copied into `row`,
+  // which keeps its capacity from row to row, and the names quoted once per frame.
+  std::vector<std::string> names;
+  names.reserve(objects.size());
+  for (const ObjectInput& o : objects) names.push_back(csv_field(o.name));
+  const auto name_of = [&](int32_t object, const Pair& p) -> const std::string& {
+    if (object < 0 || static_cast<size_t>(object) >= names.size())
+      throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
+                          std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
+                          std::to_string(object) + "; the scene has " +
+                          std::to_string(names.size()));
+    return names[object];
+  };
+  std::string row;
   const auto write_row = [&](const Pair& p) {
     char* q = after_frame + 1;
     q = std::to_chars(q, q + 12, p.a).ptr;
@@ -53,15 +78,22 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f) {
     q = std::to_chars(q, q + 12, p.poly_a).ptr;
     *q++ = ',';
     q = std::to_chars(q, q + 12, p.poly_b).ptr;
-    *q++ = '\n';
-    out.write(line, q - line);
-  };
-  const auto by_faces = [](const Pair& x, const Pair& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
+    if (names.empty()) {
+      *q++ = '\n';
+      out.write(line, q - line);
+      return;
+    }
+    row.assign(line, q);
+    row += ',';
+    row += name_of(p.object_a, p);
+    row += ',';
+    row += name_of(p.object_b, p);
+    row += '\n';
+    out.write(row.data(), static_cast<std::streamsize>(row.size()));
   };
   // Records are sorted by construction (make_frame_record); only a record built otherwise
   // pays for a sorted copy of pointers, one frame's worth.
-  if (std::is_sorted(f.pairs.begin(), f.pairs.end(), by_faces)) {
+  if (std::is_sorted(f.pairs.begin(), f.pairs.end(), pair_order)) {
     for (const Pair& p : f.pairs) write_row(p);
     return;
   }
@@ -69,31 +101,39 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f) {
   sorted.reserve(f.pairs.size());
   for (const Pair& p : f.pairs) sorted.push_back(&p);
   std::sort(sorted.begin(), sorted.end(),
-            [&](const Pair* x, const Pair* y) { return by_faces(*x, *y); });
+            [&](const Pair* x, const Pair* y) { return pair_order(*x, *y); });
   for (const Pair* p : sorted) write_row(*p);
 }
 
-void write_frames_row(std::ostream& out, const FrameRecord& f) {
+void write_frames_row(std::ostream& out, const FrameRecord& f,
+                      std::span<const ObjectInput> objects) {
   char numbers[256];
   const int64_t crossing = f.crossing_count();
   const int64_t pairs = static_cast<int64_t>(f.pairs.size());
   out << f.frame << ',' << csv_field(f.file) << ',';
-  const int n = std::snprintf(numbers, sizeof numbers,
-                              "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d\n",
-                              f.triangles, pairs, crossing, pairs - crossing, f.degenerate.size(),
-                              f.uncertain_tests, f.times.total(), f.rebuilt ? 1 : 0,
-                              f.topology_changed ? 1 : 0);
+  int n = std::snprintf(
+      numbers, sizeof numbers, "%d,%" PRId64 ",%" PRId64 ",%" PRId64 ",%zu,%" PRId64 ",%.6f,%d,%d",
+      f.triangles, pairs, crossing, pairs - crossing, f.degenerate.size(), f.uncertain_tests,
+      f.times.total(), f.rebuilt ? 1 : 0, f.topology_changed ? 1 : 0);
   out.write(numbers, n);
+  if (!objects.empty()) {
+    n = std::snprintf(numbers, sizeof numbers, ",%" PRId64 ",%" PRId64 ",%.6f", f.reused_pairs(),
+                      f.inside_vertices(), f.max_depth());
+    out.write(numbers, n);
+  }
+  out << '\n';
 }
 
 void write_pairs_csv(std::ostream& out, const Report& report) {
-  out << pairs_csv_header << '\n';
-  for (size_t i : frame_order(report)) write_pairs_rows(out, report.frames[i]);
+  out << pairs_csv_header_for(report.inputs.objects) << '\n';
+  for (size_t i : frame_order(report))
+    write_pairs_rows(out, report.frames[i], report.inputs.objects);
 }
 
 void write_frames_csv(std::ostream& out, const Report& report) {
-  out << frames_csv_header << '\n';
-  for (size_t i : frame_order(report)) write_frames_row(out, report.frames[i]);
+  out << frames_csv_header_for(report.inputs.objects) << '\n';
+  for (size_t i : frame_order(report))
+    write_frames_row(out, report.frames[i], report.inputs.objects);
 }
 
 }  // namespace snag::report

@@ -1,7 +1,9 @@
 #include "snag/report/json.h"
 
 #include <charconv>
+#include <span>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -20,12 +22,71 @@ ordered_json seconds_json(const FrameRecord& f) {
           {"confirm", f.times.confirm},   {"total", f.times.total()}};
 }
 
+/// Object `index` of a scene run, for a record's `what` (an InternalError when the record names
+/// an object the scene does not have).
+const ObjectInput& object_at(std::span<const ObjectInput> objects, int32_t index,
+                             const FrameRecord& f, const std::string& what) {
+  if (index < 0 || static_cast<size_t>(index) >= objects.size())
+    throw InternalError("report: frame " + std::to_string(f.frame) + ": " + what +
+                        " names object " + std::to_string(index) + "; the scene has " +
+                        std::to_string(objects.size()));
+  return objects[index];
+}
+
+/// A scene frame's members beyond the single-mesh ones: per object, per check, per
+/// penetration measurement, objects by name.
+void add_scene_members(ordered_json& j, const FrameRecord& f,
+                       std::span<const ObjectInput> objects) {
+  if (f.objects.size() != objects.size())
+    throw InternalError("report: frame " + std::to_string(f.frame) + " has " +
+                        std::to_string(f.objects.size()) + " object records; the scene has " +
+                        std::to_string(objects.size()) + " objects");
+  ordered_json per_object = ordered_json::array();
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const ObjectFrame& o = f.objects[i];
+    per_object.push_back({{"name", objects[i].name},
+                          {"file", o.file},
+                          {"moved", o.moved},
+                          {"rebuilt", o.rebuilt},
+                          {"build_seconds", o.build_seconds},
+                          {"refit_seconds", o.refit_seconds},
+                          {"tree_quality", o.tree_quality}});
+  }
+  ordered_json checks = ordered_json::array();
+  for (const CheckFrame& c : f.checks)
+    checks.push_back({{"objects",
+                       {object_at(objects, c.object_a, f, "a check").name,
+                        object_at(objects, c.object_b, f, "a check").name}},
+                      {"pairs", c.pairs},
+                      {"reused", c.reused},
+                      {"seconds", c.seconds}});
+  ordered_json penetration = ordered_json::array();
+  for (const Penetration& p : f.penetration)
+    penetration.push_back({{"cloth", object_at(objects, p.cloth, f, "a penetration").name},
+                           {"obstacle", object_at(objects, p.obstacle, f, "a penetration").name},
+                           {"vertices", p.vertices},
+                           {"inside", p.inside},
+                           {"ratio", p.ratio},
+                           {"max_depth", p.max_depth},
+                           {"mean_depth", p.mean_depth},
+                           {"p95_depth", p.p95_depth}});
+  j["objects"] = std::move(per_object);
+  j["checks"] = std::move(checks);
+  j["penetration"] = std::move(penetration);
+}
+
 /// A frame's record without its pairs (an empty array in their place: json_frame_element
 /// writes them, the one part of the report that grows with the pairs).
-ordered_json frame_json(const FrameRecord& f) {
+ordered_json frame_json(const FrameRecord& f, std::span<const ObjectInput> objects) {
   const int64_t crossing = f.crossing_count();
   ordered_json degenerate = ordered_json::array();
-  for (const Face& d : f.degenerate) degenerate.push_back({{"face", d.face}, {"poly", d.poly}});
+  for (const Face& d : f.degenerate) {
+    ordered_json face = {{"face", d.face}, {"poly", d.poly}};
+    if (!objects.empty())
+      face["object"] =
+          object_at(objects, d.object, f, "degenerate face " + std::to_string(d.face)).name;
+    degenerate.push_back(std::move(face));
+  }
   ordered_json j;
   j["frame"] = f.frame;
   j["file"] = f.file;
@@ -46,6 +107,7 @@ ordered_json frame_json(const FrameRecord& f) {
   j["seconds"] = seconds_json(f);
   j["pairs"] = ordered_json::array();
   j["degenerate"] = std::move(degenerate);
+  if (!objects.empty()) add_scene_members(j, f, objects);
   return j;
 }
 
@@ -102,22 +164,49 @@ ordered_json summary_json(const Report& run, const Summary& s) {
              {"file", s.worst->file},
              {"crossing", s.worst->crossing},
              {"pairs", s.worst->pairs}};
-  return {{"frames_checked", s.frames_checked},
-          {"frames_with_crossings", s.frames_with_crossings},
-          {"frames_with_pairs", s.frames_with_pairs},
-          {"worst_frame", std::move(worst)},
-          {"pairs", s.pairs},
-          {"crossing", s.crossing},
-          {"touching", s.touching},
-          {"degenerate", s.degenerate},
-          {"uncertain_tests", s.uncertain_tests},
-          {"confirmed_pairs", s.confirmed_pairs},
-          {"topology_changes", s.topology_changes},
-          {"builds", run.builds},
-          {"rebuilds", run.rebuilds},
-          {"seconds",
-           {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", run.wall_seconds}}},
-          {"failed", s.failed}};
+  ordered_json j = {{"frames_checked", s.frames_checked},
+                    {"frames_with_crossings", s.frames_with_crossings},
+                    {"frames_with_pairs", s.frames_with_pairs},
+                    {"worst_frame", std::move(worst)},
+                    {"pairs", s.pairs},
+                    {"crossing", s.crossing},
+                    {"touching", s.touching},
+                    {"degenerate", s.degenerate},
+                    {"uncertain_tests", s.uncertain_tests},
+                    {"confirmed_pairs", s.confirmed_pairs},
+                    {"topology_changes", s.topology_changes}};
+  if (run.inputs.scene()) {
+    j["reused_pairs"] = s.reused_pairs;
+    j["max_depth"] = s.max_depth;
+  }
+  j["builds"] = run.builds;
+  j["rebuilds"] = run.rebuilds;
+  j["seconds"] = {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", run.wall_seconds}};
+  j["failed"] = s.failed;
+  return j;
+}
+
+ordered_json objects_json(std::span<const ObjectInput> objects) {
+  const auto optional = [](const auto& value) {
+    return value ? ordered_json(*value) : ordered_json(nullptr);
+  };
+  ordered_json j = ordered_json::array();
+  for (const ObjectInput& o : objects)
+    j.push_back({{"name", o.name},
+                 {"role", o.role},
+                 {"sequence", o.sequence},
+                 {"group", optional(o.group)},
+                 {"still", o.still},
+                 {"weld", optional(o.weld)},
+                 {"vertices", o.vertices},
+                 {"triangles", o.triangles},
+                 {"closed", o.closed.empty() ? ordered_json(nullptr) : ordered_json(o.closed)}});
+  return j;
+}
+
+/// A name as a JSON string value, quotes included, escaped as dump_at escapes it.
+std::string json_string(const std::string& text) {
+  return ordered_json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace
@@ -129,16 +218,30 @@ std::string json_file_element(const std::string& file, bool first) {
 /// The pairs array of a frame record, laid out as dump(2) lays out the same objects when the
 /// array's member line is indented `level` times. Written by hand: a frame can have millions
 /// of pairs, and building a JSON object per pair cost more than checking the frame.
-std::string pairs_array(const std::vector<Pair>& pairs, int level) {
+/// `names`: the scene's object names as JSON strings (json_string), empty for a single mesh.
+std::string pairs_array(const FrameRecord& f, int level, std::span<const std::string> names) {
+  const std::vector<Pair>& pairs = f.pairs;
   const std::string object_margin = indent(level + 1), member_margin = indent(level + 2);
+  const bool scene = !names.empty();
   std::string out = "[";
-  out.reserve(pairs.size() * (6 * member_margin.size() + 96));
+  out.reserve(pairs.size() * ((scene ? 8 : 6) * member_margin.size() + (scene ? 160 : 96)));
   char number[16];
   const auto add_member = [&](const char* key, int32_t value, bool last) {
     out += member_margin;
     out += key;
     const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
     out.append(number, end);
+    out += last ? "\n" : ",\n";
+  };
+  const auto add_name = [&](const char* key, int32_t object, const Pair& p, bool last) {
+    if (object < 0 || static_cast<size_t>(object) >= names.size())
+      throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
+                          std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
+                          std::to_string(object) + "; the scene has " +
+                          std::to_string(names.size()));
+    out += member_margin;
+    out += key;
+    out += names[object];
     out += last ? "\n" : ",\n";
   };
   for (size_t i = 0; i < pairs.size(); ++i) {
@@ -152,7 +255,11 @@ std::string pairs_array(const std::vector<Pair>& pairs, int level) {
     out += p.kind == detect::PairKind::crossing ? "\"kind\": \"crossing\",\n"
                                                 : "\"kind\": \"touching\",\n";
     add_member("\"poly_a\": ", p.poly_a, false);
-    add_member("\"poly_b\": ", p.poly_b, true);
+    add_member("\"poly_b\": ", p.poly_b, !scene);
+    if (scene) {
+      add_name("\"object_a\": ", p.object_a, p, false);
+      add_name("\"object_b\": ", p.object_b, p, true);
+    }
     out += object_margin;
     out += '}';
   }
@@ -164,18 +271,27 @@ std::string pairs_array(const std::vector<Pair>& pairs, int level) {
   return out;
 }
 
-std::string json_frame_element(const FrameRecord& frame, bool first) {
-  std::string text = array_element(frame_json(frame), frames_level, first);
+std::string json_frame_element(const FrameRecord& frame, bool first,
+                               std::span<const ObjectInput> objects) {
+  std::string text = array_element(frame_json(frame, objects), frames_level, first);
   if (frame.pairs.empty()) return text;
   // The record's members sit two levels inside the frames array's line; its "pairs" member
   // is the only one at that indentation whose value is [] (a string value cannot hold an
-  // unescaped quote, so no file name can look like it).
+  // unescaped quote, so no file or object name can look like it; the scene members' own
+  // "pairs" sit deeper and hold numbers).
   const int member_level = frames_level + 2;
-  const std::string placeholder = "\n" + indent(member_level) + "\"pairs\": []";
+  // Built by appending: GCC 12 warns (-Wrestrict, a false positive) on "\n" + std::string
+  // once this function inlines more.
+  std::string placeholder = "\n";
+  placeholder += indent(member_level);
+  placeholder += "\"pairs\": []";
   const size_t at = text.find(placeholder);
   if (at == std::string::npos)
     throw InternalError("report.json: no pairs member in a frame record");
-  text.replace(at + placeholder.size() - 2, 2, pairs_array(frame.pairs, member_level));
+  std::vector<std::string> names;
+  names.reserve(objects.size());
+  for (const ObjectInput& o : objects) names.push_back(json_string(o.name));
+  text.replace(at + placeholder.size() - 2, 2, pairs_array(frame, member_level, names));
   return text;
 }
 
@@ -209,7 +325,9 @@ void write_report_json(std::ostream& out, const Report& run, const Summary& summ
   write_array(out, files_level, no_frames, write_files);
   out << ",\n";
   out << member("coincident_vertices", run.inputs.coincident_vertices, 2) << ",\n";
-  out << member("welded_vertices", run.inputs.welded_vertices, 2) << "\n";
+  out << member("welded_vertices", run.inputs.welded_vertices, 2);
+  if (run.inputs.scene()) out << ",\n" << member("objects", objects_json(run.inputs.objects), 2);
+  out << "\n";
   out << indent(1) << "},\n";
   out << indent(frames_level) << "\"frames\": ";
   write_array(out, frames_level, no_frames, write_frames);
@@ -228,7 +346,7 @@ std::string report_json(const Report& report) {
       },
       [&](std::ostream& frames) {
         for (size_t i = 0; i < report.frames.size(); ++i)
-          frames << json_frame_element(report.frames[i], i == 0);
+          frames << json_frame_element(report.frames[i], i == 0, report.inputs.objects);
       });
   return out.str();
 }

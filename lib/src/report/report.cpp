@@ -30,6 +30,25 @@ int64_t FrameRecord::crossing_count() const {
                        [](const Pair& p) { return p.kind == detect::PairKind::crossing; });
 }
 
+int64_t FrameRecord::reused_pairs() const {
+  int64_t n = 0;
+  for (const CheckFrame& c : checks)
+    if (c.reused) n += c.pairs;
+  return n;
+}
+
+int64_t FrameRecord::inside_vertices() const {
+  int64_t n = 0;
+  for (const Penetration& p : penetration) n += p.inside;
+  return n;
+}
+
+double FrameRecord::max_depth() const {
+  double depth = 0;
+  for (const Penetration& p : penetration) depth = std::max(depth, p.max_depth);
+  return depth;
+}
+
 FrameRecord make_frame_record(int64_t frame, std::string file, const detect::FrameResult& result,
                               std::span<const int32_t> source_polygon, int32_t vertices,
                               int64_t polygons) {
@@ -54,12 +73,12 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
                           ") is not ordered a < b");
     record.pairs.push_back({p.a, p.b, p.kind, polygon_of(p.a), polygon_of(p.b)});
   }
-  std::sort(record.pairs.begin(), record.pairs.end(),
-            [](const Pair& x, const Pair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  std::sort(record.pairs.begin(), record.pairs.end(), pair_order);
   record.degenerate.reserve(result.degenerate.size());
   for (int32_t t : result.degenerate) record.degenerate.push_back({t, polygon_of(t)});
-  std::sort(record.degenerate.begin(), record.degenerate.end(),
-            [](const Face& x, const Face& y) { return x.face < y.face; });
+  std::sort(record.degenerate.begin(), record.degenerate.end(), [](const Face& x, const Face& y) {
+    return x.object != y.object ? x.object < y.object : x.face < y.face;
+  });
   record.candidate_pairs = result.candidate_pairs;
   record.filtered_tests = result.filtered_tests;
   record.uncertain_tests = result.uncertain_tests;
@@ -85,6 +104,8 @@ void SummaryAccumulator::add(const FrameRecord& frame) {
   s.uncertain_tests += frame.uncertain_tests;
   s.confirmed_pairs += frame.confirmed_pairs;
   s.topology_changes += frame.topology_changed;
+  s.reused_pairs += frame.reused_pairs();
+  s.max_depth = std::max(s.max_depth, frame.max_depth());
   s.check_seconds += frame.times.total();
   s.read_seconds += frame.read_seconds;
   // Strictly more crossing, or as many and strictly more pairs: on a full tie the earlier

@@ -1,5 +1,6 @@
 #include "snag/report/stream.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -55,14 +56,15 @@ struct ReportStream::Files {
   StagedFile& frame_records;  ///< frames elements, one per frame added
 };
 
-ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings)
-    : accumulator_(settings.fail_on) {
+ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings,
+                           std::vector<ObjectInput> objects)
+    : objects_(std::move(objects)), accumulator_(settings.fail_on) {
   run_.snag_version = std::move(snag_version);
   run_.settings = std::move(settings);
   if (!dir) return;
   files_ = std::make_unique<Files>(*dir);
-  files_->pairs_csv.out() << pairs_csv_header << '\n';
-  files_->frames_csv.out() << frames_csv_header << '\n';
+  files_->pairs_csv.out() << pairs_csv_header_for(objects_) << '\n';
+  files_->frames_csv.out() << frames_csv_header_for(objects_) << '\n';
   writer_ = std::thread([this] { write_loop(); });
 }
 
@@ -98,10 +100,10 @@ void ReportStream::write_loop() {
 }
 
 void ReportStream::write_frame(const FrameRecord& frame, bool first) {
-  write_pairs_rows(files_->pairs_csv.out(), frame);
-  write_frames_row(files_->frames_csv.out(), frame);
+  write_pairs_rows(files_->pairs_csv.out(), frame, objects_);
+  write_frames_row(files_->frames_csv.out(), frame, objects_);
   files_->file_names.out() << json_file_element(frame.file, first);
-  files_->frame_records.out() << json_frame_element(frame, first);
+  files_->frame_records.out() << json_frame_element(frame, first, objects_);
   for (const StagedFile* f :
        {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->frame_records})
     f->check();
@@ -145,6 +147,13 @@ void ReportStream::add(FrameRecord frame) {
 Summary ReportStream::finish(const Inputs& inputs, int builds, int rebuilds, double wall_seconds) {
   if (finished_) throw InternalError("report: finished twice");
   finished_ = true;
+  const bool same_objects =
+      std::equal(inputs.objects.begin(), inputs.objects.end(), objects_.begin(), objects_.end(),
+                 [](const ObjectInput& x, const ObjectInput& y) { return x.name == y.name; });
+  if (!same_objects)
+    throw InternalError("report: finished with " + std::to_string(inputs.objects.size()) +
+                        " objects; the stream was made with " + std::to_string(objects_.size()) +
+                        " (names and order must match)");
   run_.inputs = inputs;
   run_.builds = builds;
   run_.rebuilds = rebuilds;

@@ -43,7 +43,7 @@ void write_reports(const fs::path& dir, const Report& report) {
   std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
     return report.frames[x].frame < report.frames[y].frame;
   });
-  ReportStream stream(dir, report.snag_version, report.settings);
+  ReportStream stream(dir, report.snag_version, report.settings, report.inputs.objects);
   for (size_t i : order) stream.add(report.frames[i]);
   stream.finish(report.inputs, report.builds, report.rebuilds, report.wall_seconds);
 }

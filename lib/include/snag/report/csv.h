@@ -8,9 +8,18 @@
 //   one row per checked frame in frame order; `uncertain` counts the tests left to exact
 //   arithmetic, `seconds` is the checking time (reading excluded) with 6 decimals, `rebuilt`
 //   and `topology_changed` are 0 or 1.
+//
+// A scene run (Inputs::objects not empty: --obstacle, --scene, --split-groups) has more columns,
+// only then; a single-mesh run's files keep the columns above, byte for byte:
+// pairs.csv:  ...,poly_b,object_a,object_b
+//   the objects' names (csv_field-quoted); face and poly ids are those of each object's own
+//   file, so face_a < face_b holds only within one object; rows sorted by (frame, pair_order).
+// frames.csv: ...,topology_changed,reused_pairs,inside_vertices,max_depth
+//   FrameRecord::reused_pairs(), inside_vertices() and max_depth() (6 decimals).
 #pragma once
 
 #include <ostream>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -22,18 +31,34 @@ inline constexpr std::string_view pairs_csv_header = "frame,face_a,face_b,kind,p
 inline constexpr std::string_view frames_csv_header =
     "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
     "topology_changed";
+inline constexpr std::string_view scene_pairs_csv_header =
+    "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b";
+inline constexpr std::string_view scene_frames_csv_header =
+    "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
+    "topology_changed,reused_pairs,inside_vertices,max_depth";
+
+/// The header for a run with these objects (Inputs::objects): the scene header when there
+/// are any, else the single-mesh one. Without the line end.
+std::string_view pairs_csv_header_for(std::span<const ObjectInput> objects);
+std::string_view frames_csv_header_for(std::span<const ObjectInput> objects);
 
 /// The whole files for a report in memory: the header, then every frame's rows in increasing
-/// frame number (stable, so frames recorded out of order still give sorted files).
+/// frame number (stable, so frames recorded out of order still give sorted files). The
+/// columns are chosen by report.inputs.objects (empty: single mesh).
 void write_pairs_csv(std::ostream& out, const Report& report);
 void write_frames_csv(std::ostream& out, const Report& report);
 
-/// One frame's rows of pairs.csv, its pairs sorted by (a, b) whatever their order in the
-/// record; nothing for a clean frame. The only formatter of these rows (ReportStream and
-/// write_pairs_csv both use it).
-void write_pairs_rows(std::ostream& out, const FrameRecord& frame);
-/// One frame's row of frames.csv; the only formatter of that row.
-void write_frames_row(std::ostream& out, const FrameRecord& frame);
+/// One frame's rows of pairs.csv, its pairs sorted by pair_order whatever their order in the
+/// record; nothing for a clean frame. `objects`: the run's Inputs::objects, empty for a single
+/// mesh (the object columns are left out and Pair::object_a/b are not read); in a scene run
+/// every pair's object_a and object_b must index it (else InternalError). The only formatter
+/// of these rows (ReportStream and write_pairs_csv both use it).
+void write_pairs_rows(std::ostream& out, const FrameRecord& frame,
+                      std::span<const ObjectInput> objects = {});
+/// One frame's row of frames.csv, with the scene columns when `objects` (the run's
+/// Inputs::objects) is not empty; the only formatter of that row.
+void write_frames_row(std::ostream& out, const FrameRecord& frame,
+                      std::span<const ObjectInput> objects = {});
 
 /// `field` as one CSV field: unchanged unless it holds a comma, quote, CR or LF.
 std::string csv_field(std::string_view field);

@@ -14,7 +14,21 @@
 //                  touching, degenerate, uncertain_tests, topology_changes, builds, rebuilds,
 //                  seconds: {check, read, wall}, failed} }
 //
-// Within schema version 1, fields may be added but none is removed or changes meaning.
+// A scene run (Inputs::objects not empty: --obstacle, --scene, --split-groups) adds keys, still
+// under "snag-report/2" (they are additive, and a single-mesh run's report has none of them):
+//
+//     inputs.objects: [{name, role, sequence, group | null, still, weld | null, vertices,
+//                       triangles, closed | null (cloth)}]  after welded_vertices;
+//     in each frame record: pairs[] gain object_a, object_b (names) after poly_b;
+//                           degenerate[] gain object (name); after degenerate come
+//       objects: [{name, file, moved, rebuilt, build_seconds, refit_seconds, tree_quality}]
+//                (one per object, in inputs.objects order),
+//       checks: [{objects: [name_a, name_b], pairs, reused, seconds}],
+//       penetration: [{cloth, obstacle (names), vertices, inside, ratio, max_depth,
+//                      mean_depth, p95_depth}];
+//     summary: reused_pairs, max_depth  after topology_changes.
+//
+// Within schema version 2, fields may be added but none is removed or changes meaning.
 #pragma once
 
 #include <string>

@@ -22,22 +22,70 @@ std::string_view to_string(FailOn fail_on);
 /// "crossing", "any" or "none"; nullopt otherwise.
 std::optional<FailOn> parse_fail_on(std::string_view text);
 
-/// One intersecting pair: triangle ids a < b (the file's, after fan triangulation) and the
-/// ids of the file's faces (polygons) they come from.
+/// One intersecting pair: triangle ids (the file's, after fan triangulation) and the ids of
+/// the file's faces (polygons) they come from. In a scene run each face is also named by its
+/// object (an index into Inputs::objects); pairs are ordered (object_a, a) < (object_b, b),
+/// and ids are those of each object's own file. A single-mesh run has object 0 throughout.
 struct Pair {
   int32_t a = 0;
   int32_t b = 0;
   detect::PairKind kind = detect::PairKind::crossing;
   int32_t poly_a = 0;
   int32_t poly_b = 0;
+  int32_t object_a = 0;
+  int32_t object_b = 0;
   friend bool operator==(const Pair&, const Pair&) = default;
 };
 
-/// A zero-area triangle and the file's face it comes from.
+/// Pair order in every report: by (object_a, a, object_b, b).
+inline bool pair_order(const Pair& x, const Pair& y) {
+  if (x.object_a != y.object_a) return x.object_a < y.object_a;
+  if (x.a != y.a) return x.a < y.a;
+  if (x.object_b != y.object_b) return x.object_b < y.object_b;
+  return x.b < y.b;
+}
+
+/// A zero-area triangle and the file's face it comes from (and its object, in a scene run).
 struct Face {
   int32_t face = 0;
   int32_t poly = 0;
+  int32_t object = 0;
   friend bool operator==(const Face&, const Face&) = default;
+};
+
+/// One object of a scene run in one frame.
+struct ObjectFrame {
+  std::string file;      ///< the file this frame's positions came from
+  bool moved = true;     ///< positions differ from the previous frame's (false: not refit)
+  bool rebuilt = false;  ///< its tree was (re)built for this frame
+  double build_seconds = 0;
+  double refit_seconds = 0;
+  double tree_quality = 0;
+  friend bool operator==(const ObjectFrame&, const ObjectFrame&) = default;
+};
+
+/// One check of a scene run (an object against itself, or two objects) in one frame.
+struct CheckFrame {
+  int32_t object_a = 0;
+  int32_t object_b = 0;  ///< == object_a: its self-intersections
+  int64_t pairs = 0;
+  bool reused = false;  ///< neither object moved: the previous frame's pairs, not checked again
+  double seconds = 0;   ///< traversal and narrow phase
+  friend bool operator==(const CheckFrame&, const CheckFrame&) = default;
+};
+
+/// Cloth vertices inside a closed obstacle in one frame; depths are distances to the
+/// obstacle's surface, in the files' units.
+struct Penetration {
+  int32_t cloth = 0;     ///< object index
+  int32_t obstacle = 0;  ///< object index
+  int64_t vertices = 0;  ///< the cloth's vertices measured
+  int64_t inside = 0;
+  double ratio = 0;  ///< inside / vertices
+  double max_depth = 0;
+  double mean_depth = 0;  ///< over the vertices inside (0 when none)
+  double p95_depth = 0;   ///< 95th percentile over the vertices inside, nearest rank
+  friend bool operator==(const Penetration&, const Penetration&) = default;
 };
 
 struct FrameRecord {
@@ -46,8 +94,8 @@ struct FrameRecord {
   int32_t vertices = 0;
   int32_t triangles = 0;
   int64_t polygons = 0;          ///< faces as listed in the file
-  std::vector<Pair> pairs;       ///< sorted by (a, b), unique
-  std::vector<Face> degenerate;  ///< sorted by face
+  std::vector<Pair> pairs;       ///< sorted by pair_order, unique
+  std::vector<Face> degenerate;  ///< sorted by (object, face)
   int64_t candidate_pairs = 0;
   int64_t filtered_tests = 0;
   /// Tests the double filter did not certify, decided by settings.exact_predicates (with
@@ -59,6 +107,14 @@ struct FrameRecord {
   double tree_quality = 0;
   detect::StageTimes times;  ///< checking only; times.total() is the frame's `seconds`
   double read_seconds = 0;   ///< reading (and welding) the file
+  // Scene runs only (empty otherwise): per object, per check, per (cloth, closed obstacle).
+  // objects[i] is Inputs::objects[i]: one entry per object of the scene, in that order.
+  std::vector<ObjectFrame> objects;
+  std::vector<CheckFrame> checks;
+  std::vector<Penetration> penetration;
+  int64_t reused_pairs() const;     ///< pairs of checks whose objects did not move
+  int64_t inside_vertices() const;  ///< sum of penetration[].inside
+  double max_depth() const;         ///< largest penetration[].max_depth, 0 when none
 
   int64_t crossing_count() const;
   int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
@@ -78,19 +134,39 @@ struct Settings {
   /// Who decides the tests the filter leaves: "cgal" (exact predicates) or "rounded" (the
   /// signs of the rounded doubles, mode off).
   std::string exact_predicates;
-  std::optional<double> weld;     ///< --weld tolerance, if given
-  std::string rebuild;            ///< "never", "auto" or "always"
-  double rebuild_threshold = 0;   ///< quality factor that triggers a rebuild under "auto"
+  std::optional<double> weld;    ///< --weld tolerance, if given
+  std::string rebuild;           ///< "never", "auto" or "always"
+  double rebuild_threshold = 0;  ///< quality factor that triggers a rebuild under "auto"
   FailOn fail_on = FailOn::crossing;
   std::optional<std::string> frames;  ///< --frames selection as given, if any
 };
 
+/// One object of a scene run (Inputs::objects).
+struct ObjectInput {
+  std::string name;
+  std::string role;                  ///< "cloth" or "obstacle"
+  std::string sequence;              ///< as resolved (relative to the scene file's directory)
+  std::optional<std::string> group;  ///< only this OBJ group of the files
+  bool still = false;  ///< one file for every frame: built once, never refit or uploaded again
+  std::optional<double> weld;
+  int32_t vertices = 0;   ///< first frame
+  int32_t triangles = 0;  ///< first frame
+  /// Obstacles: "closed" when penetration is measured, else why not (e.g. "edge (3, 7) is
+  /// used by 1 triangle (a hole)"); empty for cloth.
+  std::string closed;
+  friend bool operator==(const ObjectInput&, const ObjectInput&) = default;
+};
+
 struct Inputs {
-  std::string sequence;      ///< the SEQUENCE argument as given
+  std::string sequence;      ///< the SEQUENCE argument as given (a scene run: the scene file)
   std::string ids = "file";  ///< "file" (snag's OBJ/PLY readers) or "assimp"
   int64_t coincident_vertices =
       0;  ///< exactly coincident vertices beyond the first of each spot, first frame
   int64_t welded_vertices = 0;  ///< vertices merged into another by --weld, first frame
+  /// A scene run's objects (--obstacle, --scene, --split-groups); empty for a single mesh,
+  /// whose reports keep the single-mesh columns.
+  std::vector<ObjectInput> objects;
+  bool scene() const { return !objects.empty(); }
 };
 
 struct Report {
@@ -130,6 +206,8 @@ struct Summary {
   int64_t uncertain_tests = 0;
   int64_t confirmed_pairs = 0;
   int64_t topology_changes = 0;
+  int64_t reused_pairs = 0;  ///< sum of FrameRecord::reused_pairs() (scene runs; else 0)
+  double max_depth = 0;      ///< deepest Penetration::max_depth of any frame (0 when none)
   double check_seconds = 0;  ///< sum of the frames' checking times, in the order added
   double read_seconds = 0;
   bool failed = false;  ///< the run fails under settings.fail_on

@@ -25,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "snag/report/report.h"
 
@@ -36,8 +37,13 @@ class ReportStream {
   /// unusable directory throws WriteError before the first frame); nullopt keeps only the
   /// summary. `snag_version` and `settings` are report.json's head; settings.fail_on decides
   /// Summary::failed.
+  ///
+  /// `objects`: a scene run's objects (Inputs::objects), empty for a single mesh. Known up
+  /// front because they choose the CSV headers, written here, and name the objects in every
+  /// row and frame record; only their names are used before finish(), whose inputs.objects
+  /// (with the first frame's counts, say) must name the same objects in the same order.
   ReportStream(std::optional<std::filesystem::path> dir, std::string snag_version,
-               Settings settings);
+               Settings settings, std::vector<ObjectInput> objects = {});
   /// Without a successful finish() (an exception unwinding the run, say), removes every
   /// temporary: no report file appears, and an earlier run's files stay as they were.
   ~ReportStream();
@@ -46,8 +52,10 @@ class ReportStream {
 
   /// Appends a checked frame's rows. Frames must come in non-decreasing frame number (the
   /// order of checking, which the CSV files promise); an earlier number throws InternalError.
-  /// `frame.pairs` in any order (the CSV sorts them by (a, b), report.json keeps the record's
-  /// order, as the whole-report writers do).
+  /// `frame.pairs` in any order (the CSV sorts them by pair_order, report.json keeps the
+  /// record's order, as the whole-report writers do). In a scene run every object index in the
+  /// record must be one of the constructor's objects and frame.objects has one entry per
+  /// object, else the write fails with InternalError (from a later add() or finish()).
   ///
   /// The rows are formatted and written by the stream's own thread, so that a frame with
   /// millions of pairs does not hold up the check of the next: add() hands the record over
@@ -62,10 +70,12 @@ class ReportStream {
   const Summary& summary() const;
 
   /// Ends the run with what is known only at its end: `inputs` (inputs.sequence, ids and the
-  /// first frame's vertex counts; the files are the frames added), the tree builds and
-  /// rebuilds, and the run's wall-clock seconds. Writes report.json, then renames the three
-  /// files into place (see StagedFiles::commit). Returns the final summary. Throws WriteError;
-  /// after a throw no new report file is in place and no temporary is left. Call once.
+  /// first frame's vertex counts; the files are the frames added; inputs.objects, the scene's
+  /// objects as report.json lists them), the tree builds and rebuilds, and the run's
+  /// wall-clock seconds. Writes report.json, then renames the three files into place (see
+  /// StagedFiles::commit). Returns the final summary. Throws WriteError; InternalError when
+  /// inputs.objects do not have the constructor's names in its order. After a throw no new
+  /// report file is in place and no temporary is left. Call once.
   Summary finish(const Inputs& inputs, int builds, int rebuilds, double wall_seconds);
 
  private:
@@ -77,7 +87,8 @@ class ReportStream {
   /// its error, if a write failed.
   std::exception_ptr stop_writer();
 
-  Report run_;  ///< report.json's head and totals; its frames stay empty
+  Report run_;                        ///< report.json's head and totals; its frames stay empty
+  std::vector<ObjectInput> objects_;  ///< the constructor's: the names of rows and records
   SummaryAccumulator accumulator_;
   std::optional<int64_t> last_frame_;
   std::unique_ptr<Files> files_;
