@@ -18,9 +18,12 @@
 #include "progress.h"
 #include "snag/detect/checker.h"
 #include "snag/error.h"
+#include "snag/io/read_mesh.h"
 #include "snag/report/report.h"
 #include "snag/report/stream.h"
 #include "snag/report/write.h"
+#include "snag/scene/scene.h"
+#include "snag/scene/scene_frames.h"
 #include "snag/seq/sequence.h"
 #include "snag/validators/exact_modes.h"
 
@@ -40,11 +43,45 @@ detect::RebuildPolicy rebuild_policy(const std::string& name) {
   return detect::RebuildPolicy::automatic;
 }
 
-/// The frames to check, in increasing frame number.
-std::vector<seq::Frame> resolve_frames(const CheckOptions& options) {
-  std::vector<seq::Frame> frames = seq::resolve_sequence(options.sequence);
-  if (options.frames.empty()) return frames;
-  return seq::select_frames(frames, seq::FrameSelection::parse(options.frames));
+/// The objects to check: a scene file, SEQUENCE's groups (--split-groups), SEQUENCE with its
+/// obstacles (--obstacle), or SEQUENCE alone (one object, a single-mesh run). Throws
+/// UsageError for combinations that do not make one scene.
+scene::Scene scene_of(const CheckOptions& o) {
+  if (!o.scene.empty()) {
+    if (!o.sequence.empty() || !o.obstacles.empty() || o.split_groups)
+      throw UsageError(
+          "--scene describes every object: give no SEQUENCE, --obstacle or "
+          "--split-groups with it");
+    if (o.weld) throw UsageError("--weld: with --scene, give each object's \"weld\" in the file");
+    return scene::read_scene_file(o.scene);
+  }
+  if (o.sequence.empty()) throw UsageError("SEQUENCE is required (or --scene FILE)");
+  if (!o.obstacle_groups.empty() && !o.split_groups)
+    throw UsageError("--obstacle-group needs --split-groups");
+  if (o.split_groups) {
+    if (!o.obstacles.empty())
+      throw UsageError("--split-groups and --obstacle: use a scene file (--scene) to mix them");
+    const std::vector<seq::Frame> frames = seq::resolve_sequence(o.sequence);
+    const std::vector<std::string> groups = scene::face_groups(io::read_mesh(frames.front().path));
+    return scene::scene_from_groups(o.sequence, groups, o.obstacle_groups, o.weld);
+  }
+  return scene::scene_from_flags(o.sequence, o.obstacles, o.weld);
+}
+
+/// The scene's objects as report.json lists them (closedness is filled in by the run).
+std::vector<report::ObjectInput> object_inputs(const scene::ResolvedScene& scene) {
+  std::vector<report::ObjectInput> objects;
+  for (const scene::ResolvedObject& object : scene.objects) {
+    report::ObjectInput input;
+    input.name = object.spec.name;
+    input.role = object.spec.role == scene::Role::cloth ? "cloth" : "obstacle";
+    input.sequence = object.spec.sequence;
+    input.group = object.spec.group;
+    input.still = object.still;
+    input.weld = object.spec.weld;
+    objects.push_back(std::move(input));
+  }
+  return objects;
 }
 
 std::string frame_note(const report::FrameRecord& r) {
@@ -110,8 +147,21 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       "check", "Check every frame of SEQUENCE for self-intersections and report them");
   cmd->add_option("SEQUENCE", o.sequence,
                   "One OBJ/PLY (or other mesh) file, a directory of them, a pattern with %04d, "
-                  "####, @ or $F4, or a quoted glob")
-      ->required();
+                  "####, @ or $F4, or a quoted glob (the cloth; not with --scene)");
+  cmd->add_option("--obstacle", o.obstacles,
+                  "A body or prop SEQUENCE checked against the cloth (one file: still); "
+                  "repeatable. Its own self-intersections are not checked")
+      ->type_name("SEQUENCE");
+  cmd->add_option("--scene", o.scene,
+                  "A scene file (JSON): objects, their roles, checks, weld and ignore rules")
+      ->type_name("FILE");
+  cmd->add_flag("--split-groups", o.split_groups,
+                "Each OBJ o/g group of SEQUENCE is an object of its own, checked against itself "
+                "and every other group");
+  cmd->add_option("--obstacle-group", o.obstacle_groups,
+                  "With --split-groups: this group is an obstacle (not checked against itself "
+                  "or other obstacles); repeatable")
+      ->type_name("NAME");
   cmd->add_option("-o,--out", o.out_dir,
                   "Write pairs.csv, frames.csv and report.json into DIR (created if missing)")
       ->type_name("DIR");
@@ -176,7 +226,9 @@ int run_check(const CheckOptions& o) {
   const auto exact = detect::parse_exact_mode(o.exact);
   if (!exact) throw UsageError("--exact: expected off, uncertain or all, got '" + o.exact + "'");
 
-  const std::vector<seq::Frame> frames = resolve_frames(o);
+  const scene::Scene scene = scene_of(o);
+  const scene::ResolvedScene resolved = scene::resolve_scene(scene, o.frames);
+  const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
   // once rather than after an hour of checking.
   if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
@@ -202,22 +254,24 @@ int run_check(const CheckOptions& o) {
   report_settings.fail_on = *fail_on;
   if (!o.frames.empty()) report_settings.frames = o.frames;
   report::Inputs inputs;
-  inputs.sequence = o.sequence;
+  inputs.sequence = o.scene.empty() ? o.sequence : o.scene;
+  if (scene_run) inputs.objects = object_inputs(resolved);
   // Each frame's record is written to the reports' temporaries as soon as it is checked and
   // dropped: a run holds one frame's pairs, never the sequence's. The reports appear only when
   // finish() renames them into place; an exception before that (a bad frame 7) unwinds the
   // stream, which removes its temporaries.
   std::optional<std::filesystem::path> report_dir;
   if (!o.out_dir.empty()) report_dir = o.out_dir;
-  report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings));
+  report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings),
+                               inputs.objects);
 
-  Progress progress(static_cast<int64_t>(frames.size()), o.quiet);
+  Progress progress(static_cast<int64_t>(resolved.frames.size()), o.quiet);
   SequenceSettings sequence;
   sequence.weld = o.weld;
   sequence.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   sequence.gpu = backend_name == "cuda";
-  check_sequence(
-      frames, *checker, sequence, inputs,
+  check_scene(
+      resolved, *checker, sequence, scene_run, inputs,
       [&](report::FrameRecord&& record) {
         progress.update(reports.summary().frames_checked + 1, frame_note(record));
         reports.add(std::move(record));

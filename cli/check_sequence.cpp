@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <exception>
+#include <memory>
 #include <vector>
 
 #include "snag/error.h"
-#include "snag/io/read_mesh.h"
+#include "snag/measure/penetration.h"
 #include "snag/mesh/weld.h"
 #include "snag/seq/prefetch.h"
 
@@ -28,13 +30,15 @@ bool same_faces(const std::vector<geom::Tri>& a, const std::vector<geom::Tri>& b
   return true;
 }
 
+using ScenePrefetcher = seq::Prefetcher<scene::SceneFrame>;
+
 /// The next frame, or the error reading it, kept for its turn.
 struct Upcoming {
-  std::optional<seq::PrefetchedFrame> frame;
+  std::optional<ScenePrefetcher::Prefetched> frame;
   std::exception_ptr error;
 };
 
-Upcoming take_next(seq::FramePrefetcher& prefetcher) {
+Upcoming take_next(ScenePrefetcher& prefetcher) {
   Upcoming next;
   try {
     next.frame = prefetcher.next();
@@ -42,6 +46,63 @@ Upcoming take_next(seq::FramePrefetcher& prefetcher) {
     next.error = std::current_exception();
   }
   return next;
+}
+
+/// Per object: 0 when its positions in `frame` are bit for bit those in `previous`.
+std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
+                                   const scene::SceneFrame& frame) {
+  const auto& begin = frame.layout.vertex_begin;
+  std::vector<uint8_t> moved(begin.size() - 1, 1);
+  if (previous.layout.vertex_begin != begin) return moved;
+  for (size_t p = 0; p + 1 < begin.size(); ++p)
+    moved[p] = std::memcmp(previous.mesh.positions.data() + begin[p],
+                           frame.mesh.positions.data() + begin[p],
+                           static_cast<size_t>(begin[p + 1] - begin[p]) * sizeof(geom::Vec3d)) != 0;
+  return moved;
+}
+
+/// A closed obstacle's meter, and the cloths it is measured against.
+struct Meter {
+  int32_t obstacle = 0;
+  std::unique_ptr<measure::PenetrationMeter> meter;
+  std::vector<int32_t> cloths;
+};
+
+/// One object's part of a scene frame, its own ids from 0.
+std::vector<geom::Tri> local_triangles(const scene::SceneFrame& frame, int32_t object) {
+  const int32_t first = frame.layout.triangle_begin[object];
+  const int32_t last = frame.layout.triangle_begin[object + 1];
+  const int32_t base = frame.layout.vertex_begin[object];
+  std::vector<geom::Tri> local(frame.mesh.triangles.begin() + first,
+                               frame.mesh.triangles.begin() + last);
+  for (geom::Tri& t : local)
+    for (int k = 0; k < 3; ++k) t.v[k] -= base;
+  return local;
+}
+
+template <class T>
+std::span<const T> slice(const std::vector<T>& all, const std::vector<int32_t>& begin,
+                         int32_t object) {
+  return std::span<const T>(all).subspan(static_cast<size_t>(begin[object]),
+                                         static_cast<size_t>(begin[object + 1] - begin[object]));
+}
+
+/// Whether an ignore rule of either object leaves the pair of (group a, group b) out.
+bool ignored(const scene::ResolvedScene& scene, int32_t object_a, const std::string& group_a,
+             int32_t object_b, const std::string& group_b) {
+  auto matches = [](const std::string& rule, const std::string& group) {
+    return rule == "*" || rule == group;
+  };
+  for (const auto& [owner, other] :
+       {std::pair{object_a, object_b}, std::pair{object_b, object_a}}) {
+    const std::string& mine = owner == object_a ? group_a : group_b;
+    const std::string& theirs = owner == object_a ? group_b : group_a;
+    for (const scene::IgnoreRule& rule : scene.objects[owner].spec.ignore)
+      if ((matches(rule.a, mine) && matches(rule.b, theirs)) ||
+          (owner == other && matches(rule.b, mine) && matches(rule.a, theirs)))
+        return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -55,82 +116,252 @@ void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker
                     const SequenceSettings& settings, report::Inputs& inputs,
                     const std::function<void(report::FrameRecord&&)>& on_frame,
                     const std::function<void(const std::string&)>& warn) {
-  std::vector<geom::Tri> file_triangles;  // the current topology, as the file lists it
-  std::vector<int32_t> representative;    // weld representative per vertex (empty: no weld)
-  int32_t vertex_count = 0;
-  std::string first_file;
+  scene::ResolvedScene scene;
+  scene::ResolvedObject object;
+  object.spec.name = "cloth";
+  object.spec.weld = settings.weld;
+  object.frames.assign(frames.begin(), frames.end());
+  scene.objects.push_back(std::move(object));
+  scene.frames.assign(frames.begin(), frames.end());
+  scene.checks = {detect::PartCheck{0, 0}};
+  check_scene(scene, checker, settings, false, inputs, on_frame, warn);
+}
+
+void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
+                 const SequenceSettings& settings, bool scene_report, report::Inputs& inputs,
+                 const std::function<void(report::FrameRecord&&)>& on_frame,
+                 const std::function<void(const std::string&)>& warn) {
+  const auto object_count = static_cast<int32_t>(scene.objects.size());
+  if (!scene_report && object_count != 1)
+    throw InternalError("check_scene: a single-mesh report of " + std::to_string(object_count) +
+                        " objects");
+  std::vector<geom::Tri> file_triangles;  // the current topology, before welding
+  std::vector<int32_t> first_vertices;    // per object, the first frame's vertex count
+  std::vector<std::string> first_files;
+  std::vector<Meter> meters;
   bool any_assimp = false;
 
-  // Frames are read ahead on their own threads, each with its own FrameReader (which parses
-  // only positions while the faces stay those of its previous frame), while the current one
+  // Frames are read ahead on their own threads, each with its own FrameReaders (which parse
+  // only positions while the faces stay those of their previous frame), while the current one
   // is checked; at most readers + 2 frames are ahead whatever the sequence length.
+  const scene::SceneReader reader(scene);
   const int readers = readers_for(settings.threads, settings.gpu);
-  std::vector<io::FrameReader> per_reader(static_cast<size_t>(readers));
-  seq::FramePrefetcher prefetcher(std::vector<seq::Frame>(frames.begin(), frames.end()), readers,
-                                  readers + 2, [&](const seq::Frame& f, int reader) {
-                                    return per_reader[static_cast<size_t>(reader)].read(f.path);
-                                  });
+  std::vector<std::vector<io::FrameReader>> per_reader;
+  for (int r = 0; r < readers; ++r) per_reader.push_back(reader.make_readers());
+  ScenePrefetcher prefetcher(scene.frames, readers, readers + 2, [&](const seq::Frame& f, int r) {
+    // Frame numbers are unique and increasing.
+    const auto index =
+        static_cast<size_t>(std::lower_bound(scene.frames.begin(), scene.frames.end(), f,
+                                             [](const seq::Frame& x, const seq::Frame& y) {
+                                               return x.number < y.number;
+                                             }) -
+                            scene.frames.begin());
+    return reader.read(index, per_reader[static_cast<size_t>(r)]);
+  });
   // On a GPU the frame after the current one is taken first, so that its positions cross the
   // bus while the current one is checked. Its error, if reading it failed, waits for its turn.
+  // The previous frame is kept to tell which objects moved.
   Upcoming current = take_next(prefetcher);
+  std::optional<ScenePrefetcher::Prefetched> previous;
+  std::vector<report::Penetration> last_penetration;
   while (current.error || current.frame) {
     if (current.error) std::rethrow_exception(current.error);
     Upcoming following;
     if (settings.gpu) following = take_next(prefetcher);
 
     const size_t i = current.frame->index;
-    const seq::Frame& frame = frames[i];
-    const std::string file = frame.path.string();
+    const seq::Frame& frame = scene.frames[i];
     const auto read_started = Clock::now();  // welding counts as reading
-    mesh::Mesh& mesh = current.frame->mesh;
-    any_assimp = any_assimp || mesh.ids_from_assimp;
-    const int32_t vertices = static_cast<int32_t>(mesh.positions.size());
+    scene::SceneFrame& scene_frame = current.frame->item;
+    mesh::Mesh& mesh = scene_frame.mesh;
+    const detect::PartLayout& layout = scene_frame.layout;
+    any_assimp = any_assimp || scene_frame.any_assimp;
 
     bool topology_changed = false;
     if (i == 0) {
-      vertex_count = vertices;
-      first_file = file;
-    } else if (vertices != vertex_count) {
-      throw InputError(file, 0,
-                       "has " + std::to_string(vertices) + " vertices, but the first frame (" +
-                           first_file + ") has " + std::to_string(vertex_count) +
-                           "; every frame of a sequence must have the same vertices");
+      for (int32_t o = 0; o < object_count; ++o) {
+        first_vertices.push_back(layout.vertex_begin[o + 1] - layout.vertex_begin[o]);
+        first_files.push_back(scene_frame.files[o]);
+        if (scene_report) {
+          report::ObjectInput& input = inputs.objects.at(static_cast<size_t>(o));
+          input.vertices = first_vertices.back();
+          input.triangles = layout.triangle_begin[o + 1] - layout.triangle_begin[o];
+        }
+      }
     } else {
-      topology_changed = !same_faces(mesh.triangles, file_triangles);
+      for (int32_t o = 0; o < object_count; ++o) {
+        const int32_t vertices = layout.vertex_begin[o + 1] - layout.vertex_begin[o];
+        if (vertices != first_vertices[o])
+          throw InputError(scene_frame.files[o], 0,
+                           "has " + std::to_string(vertices) + " vertices" +
+                               (scene_report ? " in object \"" + scene.objects[o].spec.name + "\""
+                                             : std::string()) +
+                               ", but the first frame (" + first_files[o] + ") has " +
+                               std::to_string(first_vertices[o]) +
+                               "; every frame of a sequence must have the same vertices");
+      }
+      topology_changed = !same_faces(mesh.triangles, file_triangles) ||
+                         layout.triangle_begin != previous->item.layout.triangle_begin;
     }
 
     if (i == 0 || topology_changed) {
-      // Welding is decided once per topology, on its first frame: seams stay closed while the
-      // cloth moves, and a weld that changed from frame to frame would rebuild the tree.
-      if (settings.weld) {
-        representative = mesh::weld_representatives(mesh.positions, *settings.weld);
-        int64_t welded = 0;
-        for (size_t v = 0; v < representative.size(); ++v)
-          welded += representative[v] != static_cast<int32_t>(v);
-        if (i == 0) inputs.welded_vertices = welded;
-      } else if (i == 0) {
-        const int64_t coincident = mesh::count_coincident_vertices(mesh.positions);
-        inputs.coincident_vertices = coincident;
-        if (coincident > 0)
-          warn(file + ": " + std::to_string(coincident) +
-               (coincident == 1 ? " vertex coincides" : " vertices coincide") +
-               " exactly with another vertex but are separate vertices; unwelded seams are "
-               "reported as intersections (use --weld TOL)");
+      // Welding is decided once per topology, on its first frame, per object with its own
+      // tolerance: seams stay closed while the cloth moves, and a weld that changed from
+      // frame to frame would rebuild the tree.
+      std::vector<int32_t> representative;
+      for (int32_t o = 0; o < object_count; ++o) {
+        const std::span<const geom::Vec3d> positions =
+            slice(mesh.positions, layout.vertex_begin, o);
+        const std::optional<double>& weld = scene.objects[o].spec.weld;
+        const std::string& file = scene_frame.files[o];
+        if (weld) {
+          const std::vector<int32_t> local = mesh::weld_representatives(positions, *weld);
+          int64_t welded = 0;
+          for (size_t v = 0; v < local.size(); ++v) {
+            welded += local[v] != static_cast<int32_t>(v);
+            representative.push_back(local[v] + layout.vertex_begin[o]);
+          }
+          if (i == 0) inputs.welded_vertices += welded;
+        } else {
+          for (int32_t v = layout.vertex_begin[o]; v < layout.vertex_begin[o + 1]; ++v)
+            representative.push_back(v);
+          if (i > 0) continue;
+          const int64_t coincident = mesh::count_coincident_vertices(positions);
+          inputs.coincident_vertices += coincident;
+          if (coincident > 0)
+            warn(file + ": " + std::to_string(coincident) +
+                 (coincident == 1 ? " vertex coincides" : " vertices coincide") +
+                 " exactly with another vertex but are separate vertices; unwelded seams are "
+                 "reported as intersections (use --weld TOL)");
+        }
       }
+      bool any_weld = false;
+      for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
+        any_weld = any_weld || representative[v] != v;
+      if (!any_weld) representative.clear();
       file_triangles = mesh.triangles;
-      checker.set_triangles(mesh::welded_triangles(mesh.triangles, representative), vertex_count);
+      checker.set_scene(mesh::welded_triangles(mesh.triangles, representative),
+                        static_cast<int32_t>(mesh.positions.size()), layout, scene.checks);
+
+      // Penetration into each closed obstacle a cloth is checked against.
+      meters.clear();
+      for (const detect::PartCheck& c : scene.checks) {
+        if (c.self()) continue;
+        const auto role = [&](int32_t o) { return scene.objects[o].spec.role; };
+        if (role(c.a) == role(c.b)) continue;
+        const int32_t obstacle = role(c.a) == scene::Role::obstacle ? c.a : c.b;
+        const int32_t cloth = obstacle == c.a ? c.b : c.a;
+        auto at = std::find_if(meters.begin(), meters.end(),
+                               [&](const Meter& m) { return m.obstacle == obstacle; });
+        if (at == meters.end()) {
+          const std::vector<geom::Tri> local = local_triangles(scene_frame, obstacle);
+          const int32_t vertices =
+              layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
+          const std::optional<std::string> why = measure::why_not_closed(local, vertices);
+          if (i == 0 && scene_report) {
+            report::ObjectInput& input = inputs.objects[static_cast<size_t>(obstacle)];
+            input.closed = why ? *why : "closed";
+          }
+          if (why) continue;
+          meters.push_back(
+              {obstacle, std::make_unique<measure::PenetrationMeter>(local, vertices), {}});
+          at = meters.end() - 1;
+        }
+        at->cloths.push_back(cloth);
+      }
     }
     const double read_seconds = current.frame->read_seconds + seconds_since(read_started);
 
+    // Which objects moved since the previous frame, and the next frame's since this one.
+    std::vector<uint8_t> moved, next_moved;
+    if (previous && !topology_changed) moved = moved_between(previous->item, scene_frame);
     std::span<const geom::Vec3d> next_positions;
-    if (following.frame) next_positions = following.frame->mesh.positions;
-    const detect::FrameResult result = checker.check(mesh.positions, next_positions);
-    report::FrameRecord record = report::make_frame_record(
-        frame.number, file, result, mesh.source_polygon, vertices, mesh.polygon_count);
+    if (following.frame) {
+      next_positions = following.frame->item.mesh.positions;
+      next_moved = moved_between(scene_frame, following.frame->item);
+    }
+    const detect::FrameResult result =
+        checker.check({mesh.positions, moved, next_positions, next_moved});
+
+    report::FrameRecord record;
+    if (!scene_report) {
+      record = report::make_frame_record(
+          frame.number, frame.path.string(), result, mesh.source_polygon,
+          static_cast<int32_t>(mesh.positions.size()), scene_frame.polygons.front());
+    } else {
+      record.frame = frame.number;
+      record.file = scene_frame.files.front();
+      record.vertices = static_cast<int32_t>(mesh.positions.size());
+      record.triangles = static_cast<int32_t>(mesh.triangles.size());
+      for (int64_t p : scene_frame.polygons) record.polygons += p;
+      record.candidate_pairs = result.candidate_pairs;
+      record.filtered_tests = result.filtered_tests;
+      record.uncertain_tests = result.uncertain_tests;
+      record.confirmed_pairs = result.confirmed_pairs;
+      record.rebuilt = result.rebuilt;
+      record.tree_quality = result.tree_quality;
+      record.times = result.times;
+      const detect::Topology& topology = *checker.topology();
+      const auto group_name = [&](int32_t t) {
+        const int32_t g = mesh.triangle_group[t];
+        return g < 0 ? std::string("default") : mesh.group_names[g];
+      };
+      std::vector<report::CheckFrame> checks;
+      for (const detect::CheckOutcome& c : result.checks)
+        checks.push_back({c.part_a, c.part_b, 0, c.reused, c.seconds});
+      for (const detect::FacePair& p : result.pairs) {
+        const int32_t oa = topology.part_of(p.a), ob = topology.part_of(p.b);
+        if (ignored(scene, oa, group_name(p.a), ob, group_name(p.b))) continue;
+        record.pairs.push_back({scene_frame.file_triangle[p.a], scene_frame.file_triangle[p.b],
+                                p.kind, mesh.source_polygon[p.a], mesh.source_polygon[p.b], oa,
+                                ob});
+        for (report::CheckFrame& c : checks)
+          if (c.object_a == oa && c.object_b == ob) ++c.pairs;
+      }
+      std::sort(record.pairs.begin(), record.pairs.end(), report::pair_order);
+      for (int32_t t : result.degenerate)
+        record.degenerate.push_back(
+            {scene_frame.file_triangle[t], mesh.source_polygon[t], topology.part_of(t)});
+      record.checks = std::move(checks);
+      for (int32_t o = 0; o < object_count; ++o) {
+        const detect::PartOutcome& part = result.parts[o];
+        record.objects.push_back({scene_frame.files[o], part.moved != 0, part.rebuilt,
+                                  part.build_seconds, part.refit_seconds, part.tree_quality});
+      }
+      // Penetration: measured again only when the cloth or the obstacle moved.
+      std::vector<report::Penetration> penetration;
+      for (Meter& m : meters) {
+        const bool obstacle_moved = result.parts[m.obstacle].moved;
+        if (obstacle_moved)
+          m.meter->update_positions(slice(mesh.positions, layout.vertex_begin, m.obstacle),
+                                    settings.threads);
+        for (int32_t cloth : m.cloths) {
+          const auto kept = std::find_if(last_penetration.begin(), last_penetration.end(),
+                                         [&](const report::Penetration& p) {
+                                           return p.cloth == cloth && p.obstacle == m.obstacle;
+                                         });
+          if (!obstacle_moved && !result.parts[cloth].moved && kept != last_penetration.end()) {
+            penetration.push_back(*kept);
+            continue;
+          }
+          const measure::PenetrationStats stats =
+              m.meter->measure(slice(mesh.positions, layout.vertex_begin, cloth), settings.threads);
+          penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
+                                 stats.max_depth, stats.mean_depth, stats.p95_depth});
+        }
+      }
+      std::sort(penetration.begin(), penetration.end(),
+                [](const report::Penetration& x, const report::Penetration& y) {
+                  return x.cloth != y.cloth ? x.cloth < y.cloth : x.obstacle < y.obstacle;
+                });
+      last_penetration = penetration;
+      record.penetration = std::move(penetration);
+    }
     record.topology_changed = topology_changed;
     record.read_seconds = read_seconds;
     on_frame(std::move(record));
 
+    previous = std::move(current.frame);
     current = settings.gpu ? std::move(following) : take_next(prefetcher);
   }
   inputs.ids = any_assimp ? "assimp" : "file";

@@ -10,6 +10,7 @@
 
 #include "snag/detect/checker.h"
 #include "snag/report/report.h"
+#include "snag/scene/scene_frames.h"
 #include "snag/seq/sequence.h"
 
 namespace snag::cli {
@@ -39,5 +40,21 @@ void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker
                     const SequenceSettings& settings, report::Inputs& inputs,
                     const std::function<void(report::FrameRecord&&)>& on_frame,
                     const std::function<void(const std::string&)>& warn);
+
+/// The same loop over a scene's objects, each frame one mesh of every object laid end to end
+/// (scene::SceneReader), one tree per object:
+///  - an object whose positions are bit for bit its previous frame's is not refit, and checks
+///    between such objects keep their pairs (reported as reused); a still object is read,
+///    built and (on a GPU) uploaded once;
+///  - each object is welded with its own tolerance, and pairs its ignore rules name are left
+///    out;
+///  - cloth vertices inside each closed obstacle they are checked against are measured
+///    (report::Penetration); an obstacle that is not closed is named in inputs.objects.
+/// With `scene_report` the records and inputs.objects describe every object (a scene run);
+/// without, the scene must be one object and the records are a single mesh's.
+void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
+                 const SequenceSettings& settings, bool scene_report, report::Inputs& inputs,
+                 const std::function<void(report::FrameRecord&&)>& on_frame,
+                 const std::function<void(const std::string&)>& warn);
 
 }  // namespace snag::cli

@@ -14,6 +14,10 @@ namespace snag::cli {
 /// Options of `snag check`, filled by CLI11.
 struct CheckOptions {
   std::string sequence;
+  std::vector<std::string> obstacles;        ///< --obstacle, in order
+  std::string scene;                         ///< --scene FILE
+  bool split_groups = false;                 ///< --split-groups
+  std::vector<std::string> obstacle_groups;  ///< --obstacle-group, with --split-groups
   std::string out_dir;
   std::string frames;
   std::optional<double> weld;

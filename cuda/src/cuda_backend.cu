@@ -73,7 +73,10 @@ class CudaBackendImpl final : public CudaBackend {
     finish_limit_ = std::min<unsigned long long>(
         kFinishLimit, static_cast<unsigned long long>(initial_capacity_));
   }
-  void set_level_by_level_refit(bool on) override { tree_.level_by_level_refit = on; }
+  void set_level_by_level_refit(bool on) override {
+    level_by_level_refit_ = on;
+    for (auto& tree : trees_) tree->level_by_level_refit = on;
+  }
   void start_timer() override { span_timer_.start(stream()); }
   double stop_timer() override { return span_timer_.stop(stream()); }
 
@@ -117,64 +120,88 @@ class CudaBackendImpl final : public CudaBackend {
     current_positions_ = positions_[positions_slot_].data();
     pair_bits_ = bits_for(d.triangle_count);
     edge_bits_ = bits_for(d.edge_count);
-    tree_.resize(d.triangle_count);
-    tree_built_ = false;
-    quality_ready_ = false;
+    // One tree per part, and what each part's device data fits (PartState).
+    const int32_t parts = topology.part_count();
+    trees_.resize(static_cast<size_t>(parts));
+    for (int32_t p = 0; p < parts; ++p) {
+      if (!trees_[p]) trees_[p] = std::make_unique<DeviceTree>();
+      trees_[p]->level_by_level_refit = level_by_level_refit_;
+      trees_[p]->resize(part_size(p));
+    }
+    part_.assign(static_cast<size_t>(parts), PartState{});
+    for (int slot = 0; slot < 2; ++slot) slot_version_[slot].assign(static_cast<size_t>(parts), 0);
+    while (check_timers_.size() < topology.checks.size())
+      check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
                            initial_capacity_);
     stream_->synchronize();
   }
 
-  void set_positions(std::span<const geom::Vec3d> positions) override {
+  /// Only the parts whose slot holds another version cross the bus: a part that did not move
+  /// is copied into each of the two slots once, then never again. When the current slot holds
+  /// every part's version already (nothing moved), it stays current and nothing is copied.
+  void set_part_positions(std::span<const geom::Vec3d> positions,
+                          std::span<const uint8_t> moved) override {
     require_topology();
     if (static_cast<int64_t>(positions.size()) != topo_.vertex_count)
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
     const int slot = 1 - positions_slot_;
-    if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_) {
+    if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_ &&
+        same_moved(moved, staged_moved_)) {
       // Copied across while the previous frame was checked: the stream only waits for the copy.
       staged_ = false;
       staged_ready_.wait_on(stream());
       upload_pending_ = false;
       times_.upload = 0;
+      for (size_t p = 0; p < part_.size(); ++p) part_[p].version = staged_version_[p];
+      positions_slot_ = slot;
     } else {
       drop_staged_positions();
-      // The pinned buffer is free once its last copy is done (long ago in a checker's frame).
-      pinned_copied_[slot].synchronize();
-      std::memcpy(positions_host_[slot].data(), positions.data(), positions.size_bytes());
-      upload_timer_.start(stream());
-      SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data(), positions_host_[slot].data(),
-                                      positions.size_bytes(), cudaMemcpyHostToDevice, stream()));
-      upload_timer_.stop_async(stream());
-      pinned_copied_[slot].record(stream());
-      upload_pending_ = true;
+      const std::vector<uint64_t> versions = next_versions(moved);
+      for (size_t p = 0; p < part_.size(); ++p) part_[p].version = versions[p];
+      if (!on_resident_ && slot_version_[positions_slot_] == versions) {
+        times_.upload = 0;  // the current slot holds this frame already
+      } else {
+        // The pinned buffer is free once its last copy is done (long ago in a checker's frame).
+        pinned_copied_[slot].synchronize();
+        upload_timer_.start(stream());
+        copy_stale_parts(positions, slot, versions, stream());
+        upload_timer_.stop_async(stream());
+        pinned_copied_[slot].record(stream());
+        upload_pending_ = true;
+        positions_slot_ = slot;
+      }
     }
-    positions_slot_ = slot;
-    current_positions_ = positions_[slot].data();
-    ++positions_version_;
+    on_resident_ = false;
+    current_positions_ = positions_[positions_slot_].data();
   }
 
   /// The next frame's positions go into the slot the current frame does not use, on their own
   /// stream: the host copy into pinned memory now, while the device works on the current
   /// frame, and the transfer alongside its kernels. That slot held the previous frame, whose
-  /// work is all queued before this point on the main stream: the copy waits for it.
-  void stage_positions(std::span<const geom::Vec3d> next) override {
+  /// work is all queued before this point on the main stream: the copy waits for it. Parts
+  /// whose version that slot holds already are not copied.
+  void stage_part_positions(std::span<const geom::Vec3d> next,
+                            std::span<const uint8_t> moved) override {
     require_topology();
     if (static_cast<int64_t>(next.size()) != topo_.vertex_count) return;  // not a next frame
     drop_staged_positions();
+    const std::vector<uint64_t> versions = next_versions(moved);
+    if (slot_version_[positions_slot_] == versions) return;  // the next frame is this one
     const int slot = 1 - positions_slot_;
     const cudaStream_t upload = upload_stream_->get();
     pinned_copied_[slot].synchronize();
-    std::memcpy(positions_host_[slot].data(), next.data(), next.size_bytes());
     slot_released_.record(stream());
     slot_released_.wait_on(upload);
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data(), positions_host_[slot].data(),
-                                    next.size_bytes(), cudaMemcpyHostToDevice, upload));
+    copy_stale_parts(next, slot, versions, upload);
     pinned_copied_[slot].record(upload);
     staged_ready_.record(upload);
     staged_ = true;
     staged_data_ = next.data();
     staged_size_ = next.size();
+    staged_moved_.assign(moved.begin(), moved.end());
+    staged_version_ = versions;
   }
 
   void upload_resident_frames(std::span<const std::span<const geom::Vec3d>> frames) override {
@@ -195,36 +222,42 @@ class CudaBackendImpl final : public CudaBackend {
       throw InternalError("cuda backend: no resident frame " + std::to_string(index));
     current_positions_ =
         resident_.data() + static_cast<size_t>(index) * static_cast<size_t>(topo_.vertex_count);
-    ++positions_version_;
+    for (PartState& part : part_) part.version = ++versions_issued_;
+    on_resident_ = true;
   }
 
-  /// The scan, and ahead of the refit() and tree_quality() calls that follow it in a checker's
-  /// frame: the refit and the quality, queued before the scan's one wait (refit() and
-  /// tree_quality() then find them done). A build() in between makes them moot, not wrong.
-  detect::DegeneracyScan scan_degenerate() override {
+  /// The scan of `parts`, and ahead of the refit_part() and part_quality() calls that follow it
+  /// in a checker's frame: the refit and the quality of every built tree that does not fit the
+  /// current positions, queued before the scan's one wait (refit_part() and part_quality() then
+  /// find them done). A build in between makes them moot, not wrong.
+  detect::DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) override {
     require_topology();
-    const int32_t n = topo_.triangle_count;
     detect::DegeneracyScan scan;
-    if (n == 0) return scan;
+    if (topo_.triangle_count == 0) return scan;
     const cudaStream_t s = stream();
     timer_.start(s);
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    launch_scan_degenerate(current_positions_, topo_.triangles.data(), n,
-                           mapped(scan_degenerate_host_.data()),
-                           mapped(scan_uncertain_host_.data()), counters_.data(), s);
+    for (int32_t p : parts)
+      if (part_size(p) > 0)
+        launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(p),
+                               part_size(p), mapped(scan_degenerate_host_.data()),
+                               mapped(scan_uncertain_host_.data()), counters_.data(), s);
     SNAG_CUDA_CHECK(cudaMemcpyAsync(counters_host_.data(), counters_.data(), sizeof(FrameCounters),
                                     cudaMemcpyDeviceToHost, s));
-    const bool ahead = tree_built_ && tree_positions_ != positions_version_;
-    if (ahead) {
-      queue_refit();
-      tree_.queue_quality(s);
+    std::vector<int32_t> ahead;
+    for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
+      if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
+        ahead.push_back(p);
+    for (int32_t p : ahead) {
+      queue_refit(p);
+      trees_[p]->queue_quality(s);
     }
     timer_.stop_async(s);
-    times_.scan = timer_.elapsed();  // the wait: scan, refit and quality done
+    times_.scan = timer_.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
-    if (ahead) {
-      quality_ = tree_.queued_quality();
-      quality_ready_ = true;
+    for (int32_t p : ahead) {
+      part_[p].quality = trees_[p]->queued_quality();
+      part_[p].quality_ready = true;
     }
     const FrameCounters c = *counters_host_.data();
     scan.degenerate.assign(scan_degenerate_host_.data(),
@@ -237,64 +270,139 @@ class CudaBackendImpl final : public CudaBackend {
     return scan;
   }
 
-  void build() override {
+  void build_part(int32_t p) override {
     require_topology();
+    PartState& part = part_[p];
+    part.tree_built = true;
+    part.tree_version = part.version;
+    part.planes_version = part.version;
+    part.quality_ready = false;
+    if (part_size(p) == 0) {
+      part.quality = 0;
+      part.quality_ready = true;
+      return;
+    }
     build_timer_.start(stream());
-    tree_.build(mesh_view(), planes_.data(), stream());
+    trees_[p]->build(part_mesh(p), planes_.data() + part_begin(p), stream());
     build_timer_.stop_async(stream());
     build_pending_ = true;
-    tree_built_ = true;
-    tree_positions_ = positions_version_;
-    planes_positions_ = positions_version_;
-    quality_ready_ = false;
   }
 
   /// Skipped when the tree already fits the current positions (refit ahead in the scan, or a
   /// build): times().refit is then 0, its time being in the scan's.
-  void refit() override {
+  void refit_part(int32_t p) override {
     require_topology();
-    if (tree_built_ && tree_positions_ == positions_version_) {
+    if (part_[p].tree_built && part_[p].tree_version == part_[p].version) {
       times_.refit = 0;
       return;
     }
-    queue_refit();
+    queue_refit(p);
   }
 
-  double tree_quality() override {
+  double part_quality(int32_t p) override {
     require_topology();
-    if (quality_ready_) return quality_;
+    PartState& part = part_[p];
+    if (part.quality_ready) return part.quality;
     timer_.start(stream());
-    tree_.queue_quality(stream());
+    trees_[p]->queue_quality(stream());
     timer_.stop_async(stream());
     times_.quality = timer_.elapsed();
     collect_times();
-    quality_ = tree_.queued_quality();
-    quality_ready_ = true;
-    return quality_;
+    part.quality = trees_[p]->queued_quality();
+    part.quality_ready = true;
+    return part.quality;
   }
 
   std::vector<int32_t> triangle_order() override {
     stream_->synchronize();  // a build may still be queued
-    std::vector<int32_t> order(static_cast<size_t>(tree_.shape().leaf_count));
+    std::vector<int32_t> order(static_cast<size_t>(trees_.at(0)->shape().leaf_count));
     if (!order.empty())
-      SNAG_CUDA_CHECK(cudaMemcpy(order.data(), tree_.view().triangle_at,
+      SNAG_CUDA_CHECK(cudaMemcpy(order.data(), trees_[0]->view().triangle_at,
                                  order.size() * sizeof(int32_t), cudaMemcpyDeviceToHost));
     return order;
   }
 
   std::vector<geom::Box3f> node_boxes() override {
     stream_->synchronize();  // a build or a refit may still be queued
-    const int32_t n = tree_.shape().leaf_count;
+    const int32_t n = trees_.at(0)->shape().leaf_count;
     std::vector<geom::Box3f> boxes(n > 0 ? static_cast<size_t>(2 * n - 1) : 0);
     if (!boxes.empty())
-      SNAG_CUDA_CHECK(cudaMemcpy(boxes.data(), tree_.view().boxes,
+      SNAG_CUDA_CHECK(cudaMemcpy(boxes.data(), trees_[0]->view().boxes,
                                  boxes.size() * sizeof(geom::Box3f), cudaMemcpyDeviceToHost));
     return boxes;
   }
 
-  detect::FilteredFrame detect(std::span<const int32_t> degenerate, detect::FilterUse use) override;
+  detect::FilteredFrame detect_checks(std::span<const int32_t> degenerate, detect::FilterUse use,
+                                      std::span<const int32_t> checks) override;
+
+ protected:
+  int32_t part_count() const override { return topology_ ? topology_->part_count() : 0; }
+  int32_t check_count() const override {
+    return topology_ ? static_cast<int32_t>(topology_->checks.size()) : 0;
+  }
 
  private:
+  /// What one part's device data fits, as versions: each set of positions gives every part
+  /// that moved a new number (versions_issued_), so equal numbers mean equal positions.
+  struct PartState {
+    uint64_t version = 0;         ///< of the current positions
+    uint64_t tree_version = 0;    ///< the tree's boxes fit this version
+    uint64_t planes_version = 0;  ///< planes_ of the part's triangles fit this version
+    bool tree_built = false;
+    bool quality_ready = false;
+    double quality = 0;
+  };
+
+  int32_t part_begin(int32_t p) const { return topology_->layout.triangle_begin[p]; }
+  int32_t part_size(int32_t p) const {
+    return topology_->layout.triangle_begin[p + 1] - topology_->layout.triangle_begin[p];
+  }
+  /// Part p's triangles over the whole frame's positions: its tree's triangle ids are local.
+  mesh::MeshView part_mesh(int32_t p) const {
+    return {current_positions_, topo_.triangles.data() + part_begin(p), topo_.vertex_count,
+            part_size(p)};
+  }
+
+  /// The versions of a frame whose parts moved as `moved` says (empty: all of them).
+  std::vector<uint64_t> next_versions(std::span<const uint8_t> moved) {
+    std::vector<uint64_t> versions(part_.size());
+    for (size_t p = 0; p < part_.size(); ++p)
+      versions[p] = moved.empty() || moved[p] || part_[p].version == 0 ? ++versions_issued_
+                                                                       : part_[p].version;
+    return versions;
+  }
+  static bool same_moved(std::span<const uint8_t> a, const std::vector<uint8_t>& b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin());
+  }
+
+  /// Copies into `slot` (through its pinned buffer) the vertices of every part whose version
+  /// there is not `versions`' (neighbouring parts in one copy), on `s`, and records the slot's
+  /// new versions.
+  void copy_stale_parts(std::span<const geom::Vec3d> positions, int slot,
+                        const std::vector<uint64_t>& versions, cudaStream_t s) {
+    const auto& vertex_begin = topology_->layout.vertex_begin;
+    const int32_t parts = static_cast<int32_t>(part_.size());
+    for (int32_t p = 0; p < parts;) {
+      if (slot_version_[slot][p] == versions[p]) {
+        ++p;
+        continue;
+      }
+      int32_t q = p;
+      while (q < parts && slot_version_[slot][q] != versions[q])
+        slot_version_[slot][q] = versions[q], ++q;
+      const size_t first = static_cast<size_t>(vertex_begin[p]);
+      const size_t count = static_cast<size_t>(vertex_begin[q]) - first;
+      if (count) {
+        std::memcpy(positions_host_[slot].data() + first, positions.data() + first,
+                    count * sizeof(geom::Vec3d));
+        SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first,
+                                        positions_host_[slot].data() + first,
+                                        count * sizeof(geom::Vec3d), cudaMemcpyHostToDevice, s));
+      }
+      p = q;
+    }
+  }
+
   cudaStream_t stream() const { return stream_->get(); }
 
   /// Forgets a staged frame that was not the next one set, once its copy (which writes the
@@ -309,18 +417,15 @@ class CudaBackendImpl final : public CudaBackend {
     if (!topology_) throw InternalError("cuda backend: no topology set");
   }
 
-  mesh::MeshView mesh_view() const {
-    return {current_positions_, topo_.triangles.data(), topo_.vertex_count, topo_.triangle_count};
-  }
-
-  void queue_refit() {
+  void queue_refit(int32_t p) {
+    if (part_size(p) == 0) return;  // built empty: nothing to refit
     refit_timer_.start(stream());
-    tree_.refit(mesh_view(), planes_.data(), stream());
+    trees_[p]->refit(part_mesh(p), planes_.data() + part_begin(p), stream());
     refit_timer_.stop_async(stream());
     refit_pending_ = true;
-    tree_positions_ = positions_version_;
-    planes_positions_ = positions_version_;
-    quality_ready_ = false;
+    part_[p].tree_version = part_[p].version;
+    part_[p].planes_version = part_[p].version;
+    part_[p].quality_ready = false;
   }
 
   /// Stage times whose stop events the stream has passed (called after a wait).
@@ -359,12 +464,18 @@ class CudaBackendImpl final : public CudaBackend {
   mutable StageTimes times_;
   const detect::Topology* topology_ = nullptr;
   DeviceTopology topo_;
-  DeviceTree tree_;
+  std::vector<std::unique_ptr<DeviceTree>> trees_;  // per part
+  std::vector<PartState> part_;
+  uint64_t versions_issued_ = 0;
+  bool level_by_level_refit_ = false;
+  std::vector<std::unique_ptr<EventTimer>> check_timers_;  // per check, when several run
   // Positions in two slots, so that the next frame is copied in while the current one is
   // checked (stage_positions); positions_slot_ is the current frame's.
   DeviceBuffer<geom::Vec3d> positions_[2], resident_;
   PinnedBuffer<geom::Vec3d> positions_host_[2];
   int positions_slot_ = 0;
+  std::vector<uint64_t> slot_version_[2];  // per slot, per part: the version it holds (0: none)
+  bool on_resident_ = false;               // current_positions_ is a resident frame
   std::unique_ptr<Stream> upload_stream_;
   Event pinned_copied_[2];  // the last copy out of each pinned buffer
   Event slot_released_;     // main-stream work queued before a staged copy
@@ -372,6 +483,8 @@ class CudaBackendImpl final : public CudaBackend {
   bool staged_ = false;
   const geom::Vec3d* staged_data_ = nullptr;  // the staged frame, as the caller holds it
   size_t staged_size_ = 0;
+  std::vector<uint8_t> staged_moved_;     // as the caller said
+  std::vector<uint64_t> staged_version_;  // the versions it gets when set
   const geom::Vec3d* current_positions_ = nullptr;
   int resident_count_ = 0;
   DeviceBuffer<geom::PlaneCoefficients> planes_;
@@ -392,11 +505,6 @@ class CudaBackendImpl final : public CudaBackend {
   mutable EventTimer upload_timer_, build_timer_, refit_timer_;
   mutable bool upload_pending_ = false, build_pending_ = false, refit_pending_ = false;
   EventTimer narrow_timer_;
-  // Which positions the tree and the planes fit: positions_version_ counts set_positions and
-  // select_resident_frame calls.
-  uint64_t positions_version_ = 0, tree_positions_ = ~uint64_t{0}, planes_positions_ = ~uint64_t{0};
-  bool tree_built_ = false, quality_ready_ = false;
-  double quality_ = 0;
   unsigned long long finish_limit_ = kFinishLimit;
   HostResults host_results_;  // device addresses of the host_* buffers
   int64_t initial_capacity_ = 1 << 16;
@@ -426,8 +534,9 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
   return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
 }
 
-detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerate,
-                                              detect::FilterUse use) {
+detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> degenerate,
+                                                     detect::FilterUse use,
+                                                     std::span<const int32_t> checks) {
   require_topology();
   detect::FilteredFrame frame;
   const int32_t n = topo_.triangle_count;
@@ -437,10 +546,15 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
   timer_.start(s);
 
   const uint8_t* owned = prepare_degenerate(degenerate);
-  if (planes_positions_ != positions_version_) {
-    launch_planes(current_positions_, topo_.triangles.data(), n, planes_.data(), s);
-    planes_positions_ = positions_version_;
-  }
+  // The planes of the parts the checks read, where no refit or build computed them.
+  for (int32_t c : checks)
+    for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b}) {
+      PartState& part = part_[p];
+      if (part.planes_version == part.version || part_size(p) == 0) continue;
+      launch_planes(current_positions_, topo_.triangles.data() + part_begin(p), part_size(p),
+                    planes_.data() + part_begin(p), s);
+      part.planes_version = part.version;
+    }
   PairInputs inputs;
   inputs.frame = {current_positions_, planes_.data()};
   inputs.topology.triangles = topo_.triangles.data();
@@ -478,8 +592,26 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
     SNAG_CUDA_CHECK(
         cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
-    launch_narrow_phase(tree_.view(), inputs, topo_.neighbor_pairs.data(),
-                        topo_.neighbor_shared.data(), topo_.neighbor_pair_count, results, use, s);
+    const bool time_each = checks.size() > 1;
+    for (size_t i = 0; i < checks.size(); ++i) {
+      const detect::PartCheck check = topology_->checks[checks[i]];
+      if (time_each) check_timers_[i]->start(s);
+      if (check.self()) {
+        const int64_t first = topology_->self_neighbors[2 * check.a];
+        const int64_t count = topology_->self_neighbors[2 * check.a + 1] - first;
+        if (part_size(check.a) > 0)
+          launch_narrow_phase(trees_[check.a]->view(), part_begin(check.a), inputs,
+                              topo_.neighbor_pairs.data() + first,
+                              topo_.neighbor_shared.data() + first, count, results, use, s);
+      } else {
+        // One thread per leaf of the larger part, walking the smaller one's tree.
+        const bool a_larger = part_size(check.a) >= part_size(check.b);
+        const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
+        launch_cross_phase(trees_[big]->view(), part_begin(big), trees_[small]->view(),
+                           part_begin(small), inputs, results, use, s);
+      }
+      if (time_each) check_timers_[i]->stop_async(s);
+    }
     narrow_timer_.stop_async(s);
     launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
                   counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),
@@ -506,6 +638,10 @@ detect::FilteredFrame CudaBackendImpl::detect(std::span<const int32_t> degenerat
   }
   times_.classify = timer_.elapsed() - times_.traverse;
   frame.traverse_seconds = seconds_since(start);
+  // Device time of each check (a single one: the traversal's, memsets included).
+  for (size_t i = 0; i < checks.size(); ++i)
+    frame.check_seconds.push_back(
+        (checks.size() > 1 ? check_timers_[i]->elapsed() : times_.traverse) * 1e-3);
   frame.candidate_pairs = static_cast<int64_t>(c.candidates);
 
   const auto classify_start = Clock::now();

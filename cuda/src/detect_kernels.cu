@@ -62,10 +62,11 @@ __device__ __forceinline__ void add_warp_total(unsigned long long value,
 }
 
 __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles,
-                                       int32_t n, int32_t* degenerate, int32_t* uncertain,
-                                       FrameCounters* counters) {
-  const int32_t t = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (t >= n) return;
+                                       int32_t first, int32_t n, int32_t* degenerate,
+                                       int32_t* uncertain, FrameCounters* counters) {
+  const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (i >= n) return;
+  const int32_t t = first + i;
   const geom::FilteredPredicates pred{positions};
   const geom::Tri tri = triangles[t];
   const geom::Answer answer = geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]);
@@ -101,14 +102,16 @@ __device__ __forceinline__ void neighbor_pair(const PairInputs& in,
 
 /// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
 /// neighbours and follow nearly the same path; pairs of the neighbour list are skipped.
+/// The tree's triangle ids are its part's: `base` is the part's first triangle.
 template <detect::FilterUse use>
-__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const PairInputs& in,
-                                              int32_t position, DeviceSink& sink,
-                                              unsigned long long& candidates) {
-  const int32_t t = tree.triangle_at[position];
+__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, int32_t base,
+                                              const PairInputs& in, int32_t position,
+                                              DeviceSink& sink, unsigned long long& candidates) {
+  const int32_t t = base + tree.triangle_at[position];
   if (in.degenerate[t]) return;
   const geom::Tri tt = in.topology.triangles[t];
-  bvh::for_each_later_overlap(tree, position, [&](int32_t x) {
+  bvh::for_each_later_overlap(tree, position, [&](int32_t local_x) {
+    const int32_t x = base + local_x;
     if (in.degenerate[x] ||
         detect::is_listed_neighbor(tt, in.topology.triangles[x], in.topology.listed_vertex,
                                    in.topology.every_vertex_listed))
@@ -122,18 +125,45 @@ __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, const P
 /// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
 template <detect::FilterUse use>
 __global__ void __launch_bounds__(kNarrowBlock)
-    narrow_phase_kernel(bvh::TreeView tree, PairInputs in, const std::array<int32_t, 2>* pairs,
-                        const uint8_t* shared_masks, int64_t pair_count, unsigned traverse_blocks,
-                        ResultBuffers out) {
+    narrow_phase_kernel(bvh::TreeView tree, int32_t base, PairInputs in,
+                        const std::array<int32_t, 2>* pairs, const uint8_t* shared_masks,
+                        int64_t pair_count, unsigned traverse_blocks, ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
   if (blockIdx.x < traverse_blocks) {
     const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
     if (position < tree.shape.leaf_count)
-      traverse_leaf<use>(tree, in, position, sink, candidates);
+      traverse_leaf<use>(tree, base, in, position, sink, candidates);
   } else {
     const int64_t i = static_cast<int64_t>(blockIdx.x - traverse_blocks) * blockDim.x + threadIdx.x;
     if (i < pair_count) neighbor_pair<use>(in, pairs, shared_masks, i, sink, candidates);
+  }
+  add_warp_total(candidates, &out.counters->candidates);
+  add_warp_total(sink.misses, &out.counters->misses);
+  add_warp_total(sink.expanded, &out.counters->expanded);
+}
+
+/// Two parts: one thread per leaf of `tree` (part a, first triangle base_a), in leaf order,
+/// walking the whole of `other` (part b). Parts share no vertex: no shared corners, no
+/// neighbour list.
+template <detect::FilterUse use>
+__global__ void __launch_bounds__(kNarrowBlock)
+    cross_phase_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other, int32_t base_b,
+                       PairInputs in, ResultBuffers out) {
+  DeviceSink sink{out};
+  unsigned long long candidates = 0;
+  const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (position < tree.shape.leaf_count) {
+    const int32_t t = base_a + tree.triangle_at[position];
+    if (!in.degenerate[t]) {
+      const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
+      bvh::for_each_overlap(other, box, [&](int32_t local_x) {
+        const int32_t x = base_b + local_x;
+        if (in.degenerate[x]) return;
+        ++candidates;
+        detect::test_pair<use>(in.frame, in.topology, t, x, 0u, 0u, sink);
+      });
+    }
   }
   add_warp_total(candidates, &out.counters->candidates);
   add_warp_total(sink.misses, &out.counters->misses);
@@ -249,10 +279,10 @@ __global__ void __launch_bounds__(kFinishThreads)
 
 }  // namespace
 
-void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
-                            int32_t* degenerate, int32_t* uncertain, FrameCounters* counters,
-                            cudaStream_t stream) {
-  launch(scan_degenerate_kernel, n, stream, positions, triangles, n, degenerate, uncertain,
+void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
+                            int32_t n, int32_t* degenerate, int32_t* uncertain,
+                            FrameCounters* counters, cudaStream_t stream) {
+  launch(scan_degenerate_kernel, n, stream, positions, triangles, first, n, degenerate, uncertain,
          counters);
 }
 
@@ -266,20 +296,33 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
   launch(planes_kernel, n, stream, positions, triangles, n, planes);
 }
 
-void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
+void launch_narrow_phase(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs,
                          const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, detect::FilterUse use,
-                         cudaStream_t stream) {
-  const int64_t traverse_blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
+                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream) {
+  const int64_t traverse_blocks =
+      tree.shape.leaf_count > 0 ? (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock : 0;
   const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
   if (blocks == 0) return;
   const auto kernel = use == detect::FilterUse::certify
                           ? narrow_phase_kernel<detect::FilterUse::certify>
                           : narrow_phase_kernel<detect::FilterUse::defer_all>;
   kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
-      tree, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count,
+      tree, base, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count,
       static_cast<unsigned>(traverse_blocks), results);
+  SNAG_CUDA_CHECK_LAUNCH();
+}
+
+void launch_cross_phase(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
+                        int32_t base_b, const PairInputs& inputs, const ResultBuffers& results,
+                        detect::FilterUse use, cudaStream_t stream) {
+  if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
+  const int64_t blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
+  const auto kernel = use == detect::FilterUse::certify
+                          ? cross_phase_kernel<detect::FilterUse::certify>
+                          : cross_phase_kernel<detect::FilterUse::defer_all>;
+  kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(tree, base_a, other, base_b,
+                                                                     inputs, results);
   SNAG_CUDA_CHECK_LAUNCH();
 }
 

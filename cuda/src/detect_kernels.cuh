@@ -82,11 +82,12 @@ struct PairInputs {
 /// Kernel attributes (finish_kernel's shared memory) on the current device: once per backend.
 void configure_kernels();
 
-/// Degenerate-triangle scan: appends ids the filter finds degenerate to `degenerate` and ids it
-/// cannot decide to `uncertain` (both in any order), counting them in counters.
-void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
-                            int32_t* degenerate, int32_t* uncertain, FrameCounters* counters,
-                            cudaStream_t stream);
+/// Degenerate-triangle scan of triangles [first, first + n): appends ids the filter finds
+/// degenerate to `degenerate` and ids it cannot decide to `uncertain` (both in any order),
+/// counting them in counters.
+void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
+                            int32_t n, int32_t* degenerate, int32_t* uncertain,
+                            FrameCounters* counters, cudaStream_t stream);
 
 /// Sets degenerate[list[i]] = 1.
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
@@ -97,16 +98,22 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream);
 
-/// The candidate pairs of the traversal (one thread per leaf position, in leaf order) and those
-/// of the neighbour list (one thread per pair), each through detect::test_candidate_pair: one
+/// A part against itself: the candidate pairs of the traversal of its tree (one thread per leaf
+/// position, in leaf order; the tree's triangle ids plus `base` are the topology's) and those
+/// of its neighbour list (one thread per pair), each through detect::test_candidate_pair: one
 /// launch, the traversal's blocks first (they run longest). With FilterUse::defer_all every
 /// test goes to the uncertain buffer (`--exact all`); a kernel of its own, so that the usual
 /// one carries no branch for it.
-void launch_narrow_phase(const bvh::TreeView& tree, const PairInputs& inputs,
+void launch_narrow_phase(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                          const std::array<int32_t, 2>* neighbor_pairs,
                          const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, detect::FilterUse use,
-                         cudaStream_t stream);
+                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream);
+
+/// Two parts: one thread per leaf of `tree` (part a, whose first triangle is base_a) walking
+/// all of `other` (part b), each overlap through detect::test_pair (no shared corners).
+void launch_cross_phase(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
+                        int32_t base_b, const PairInputs& inputs, const ResultBuffers& results,
+                        detect::FilterUse use, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with

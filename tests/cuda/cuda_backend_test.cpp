@@ -12,6 +12,7 @@
 
 #include "detect_cases.h"
 #include "require_gpu.h"
+#include "scene_cases.h"
 #include "snag/bvh/tree.h"
 #include "snag/cuda/cuda_backend.h"
 #include "snag/detect/cpu_backend.h"
@@ -447,6 +448,62 @@ TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
     EXPECT_EQ(g.tree_quality, c.tree_quality) << "frame " << f;
     EXPECT_EQ(g.pairs, brute_force(frames[f])) << "frame " << f;
   }
+}
+
+TEST(CudaScene, ScenesMatchTheCpuAndBruteForceAsPartsMoveAndRest) {
+  SNAG_REQUIRE_GPU();
+  // A folded cloth, a lattice body and a second sheet, checked as a scene frame after frame:
+  // the cloth moves every frame, the body never, the sheet in some; frames 6 and 7 are frozen.
+  // Next frames are staged with what moves in them. Every frame's pairs, degenerate faces,
+  // candidates and per-check outcomes are the CPU's, and the pairs brute force's.
+  const SmallMesh cloth = folded_grid(40, 12), body = lattice_soup(300, 200, 9, 3),
+                  sheet = folded_grid(20, 9);
+  Laid laid = lay_end_to_end({cloth, body, sheet});
+  const std::vector<detect::PartCheck> checks = {{0, 0}, {0, 1}, {0, 2}, {2, 2}};
+  std::vector<std::vector<geom::Vec3d>> frames;
+  std::vector<std::vector<uint8_t>> moved;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> step(-1, 1);
+  std::vector<geom::Vec3d> positions = laid.mesh.positions;
+  for (int f = 0; f < 10; ++f) {
+    std::vector<uint8_t> m = {1, 0, static_cast<uint8_t>(f % 3 == 0)};
+    if (f == 6 || f == 7) m = {0, 0, 0};
+    if (f > 0)
+      for (int32_t part : {0, 2})
+        if (m[part])
+          for (int32_t v = laid.layout.vertex_begin[part]; v < laid.layout.vertex_begin[part + 1];
+               ++v)
+            positions[v] = positions[v] + geom::Vec3d{double(step(rng)), double(step(rng)), 0.0};
+    frames.push_back(positions);
+    moved.push_back(m);
+  }
+  auto resolver = std::make_shared<IntegerResolver>();
+  detect::Checker gpu(gpu_backend(), resolver), cpu(detect::make_cpu_backend(2), resolver);
+  const auto vertices = static_cast<int32_t>(laid.mesh.positions.size());
+  for (detect::Checker* c : {&gpu, &cpu})
+    c->set_scene(laid.mesh.triangles, vertices, laid.layout, checks);
+  for (int f = 0; f < 10; ++f) {
+    detect::FrameInput input{frames[f], moved[f], {}, {}};
+    if (f + 1 < 10 && f != 4) {
+      input.next_positions = frames[f + 1];
+      input.next_moved = moved[f + 1];
+    }
+    const detect::FrameResult g = gpu.check(input);
+    const detect::FrameResult c = cpu.check({frames[f], moved[f], {}, {}});
+    SmallMesh frame_mesh{frames[f], laid.mesh.triangles};
+    EXPECT_EQ(g.pairs, c.pairs) << "frame " << f;
+    EXPECT_EQ(g.pairs, expected_pairs({frame_mesh, laid.layout}, checks)) << "frame " << f;
+    EXPECT_EQ(g.degenerate, c.degenerate) << "frame " << f;
+    EXPECT_EQ(g.candidate_pairs, c.candidate_pairs) << "frame " << f;
+    ASSERT_EQ(g.checks.size(), c.checks.size());
+    for (size_t k = 0; k < g.checks.size(); ++k) {
+      EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs) << "frame " << f << " check " << k;
+      EXPECT_EQ(g.checks[k].reused, c.checks[k].reused) << "frame " << f << " check " << k;
+    }
+    for (size_t p = 0; p < g.parts.size(); ++p)
+      EXPECT_EQ(g.parts[p].tree_quality, c.parts[p].tree_quality) << "frame " << f;
+  }
+  EXPECT_EQ(gpu.build_count(), 3);
 }
 
 TEST(CudaBackend, BadDeviceIsAnError) {

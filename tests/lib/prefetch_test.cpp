@@ -45,7 +45,7 @@ TEST(FramePrefetcher, FramesComeOutInOrderOnceEach) {
       size_t expected = 0;
       while (auto next = prefetcher.next()) {
         ASSERT_EQ(next->index, expected) << readers << " readers, depth " << depth;
-        ASSERT_EQ(next->mesh.positions.at(0).x, static_cast<double>(expected + 1));
+        ASSERT_EQ(next->item.positions.at(0).x, static_cast<double>(expected + 1));
         EXPECT_GE(next->read_seconds, 0.0);
         ++expected;
       }

@@ -41,45 +41,68 @@ class CpuBackend final : public Backend {
 
   std::string_view name() const override { return "cpu"; }
 
-  void set_topology(const Topology& topology) override { topology_ = &topology; }
+  void set_topology(const Topology& topology) override {
+    topology_ = &topology;
+    trees_.assign(static_cast<size_t>(topology.part_count()), bvh::Tree{});
+  }
 
-  void set_positions(std::span<const geom::Vec3d> positions) override { positions_ = positions; }
+  void set_part_positions(std::span<const geom::Vec3d> positions,
+                          std::span<const uint8_t>) override {
+    positions_ = positions;
+  }
 
-  DegeneracyScan scan_degenerate() override {
+  DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) override {
     const geom::FilteredPredicates pred{positions_.data()};
-    const int32_t n = topology_->triangle_count();
-    std::vector<uint8_t> answer(static_cast<size_t>(n));
-#pragma omp parallel for num_threads(threads_) schedule(static)
-    for (int32_t t = 0; t < n; ++t) {
-      const geom::Tri tri = topology_->triangles[t];
-      answer[t] = static_cast<uint8_t>(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
-    }
     DegeneracyScan scan;
-    for (int32_t t = 0; t < n; ++t) {
-      if (answer[t] == static_cast<uint8_t>(geom::Answer::yes)) scan.degenerate.push_back(t);
-      if (answer[t] == static_cast<uint8_t>(geom::Answer::uncertain)) scan.uncertain.push_back(t);
+    for (int32_t part : parts) {
+      const int32_t begin = topology_->layout.triangle_begin[part];
+      const int32_t end = topology_->layout.triangle_begin[part + 1];
+      std::vector<uint8_t> answer(static_cast<size_t>(end - begin));
+#pragma omp parallel for num_threads(threads_) schedule(static)
+      for (int32_t t = begin; t < end; ++t) {
+        const geom::Tri tri = topology_->triangles[t];
+        answer[t - begin] =
+            static_cast<uint8_t>(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
+      }
+      for (int32_t t = begin; t < end; ++t) {
+        if (answer[t - begin] == static_cast<uint8_t>(geom::Answer::yes))
+          scan.degenerate.push_back(t);
+        if (answer[t - begin] == static_cast<uint8_t>(geom::Answer::uncertain))
+          scan.uncertain.push_back(t);
+      }
     }
+    std::sort(scan.degenerate.begin(), scan.degenerate.end());
+    std::sort(scan.uncertain.begin(), scan.uncertain.end());
     return scan;
   }
 
-  void build() override {
-    tree_.build(mesh_view(), threads_);
+  void build_part(int32_t part) override {
+    trees_[part].build(part_view(part), threads_);
   }
-  void refit() override {
-    tree_.refit(mesh_view(), threads_);
+  void refit_part(int32_t part) override {
+    trees_[part].refit(part_view(part), threads_);
   }
-  double tree_quality() override {
-    return tree_.quality();
+  double part_quality(int32_t part) override {
+    return trees_[part].quality();
   }
 
-  FilteredFrame detect(std::span<const int32_t> degenerate, FilterUse use) override {
-    return use == FilterUse::certify ? detect_with<FilterUse::certify>(degenerate)
-                                     : detect_with<FilterUse::defer_all>(degenerate);
+  FilteredFrame detect_checks(std::span<const int32_t> degenerate, FilterUse use,
+                              std::span<const int32_t> checks) override {
+    return use == FilterUse::certify ? detect_with<FilterUse::certify>(degenerate, checks)
+                                     : detect_with<FilterUse::defer_all>(degenerate, checks);
+  }
+
+ protected:
+  int32_t part_count() const override {
+    return topology_ ? topology_->part_count() : 0;
+  }
+  int32_t check_count() const override {
+    return topology_ ? static_cast<int32_t>(topology_->checks.size()) : 0;
   }
 
  private:
   template <FilterUse use>
-  FilteredFrame detect_with(std::span<const int32_t> degenerate) {
+  FilteredFrame detect_with(std::span<const int32_t> degenerate, std::span<const int32_t> checks) {
     const Topology& topo = *topology_;
     const int32_t n = topo.triangle_count();
     FilteredFrame frame;
@@ -96,47 +119,31 @@ class CpuBackend final : public Backend {
                             topo.every_vertex_listed,
                             n,
                             static_cast<int32_t>(topo.edges.size())};
+    // The planes of the parts the checks read.
     planes_.resize(static_cast<size_t>(n));
     if constexpr (use == FilterUse::certify) {
+      std::vector<uint8_t> needed(static_cast<size_t>(topo.part_count()), 0);
+      for (int32_t c : checks) needed[topo.checks[c].a] = needed[topo.checks[c].b] = 1;
+      for (int32_t part = 0; part < topo.part_count(); ++part) {
+        if (!needed[part]) continue;
+        const int32_t begin = topo.layout.triangle_begin[part];
+        const int32_t end = topo.layout.triangle_begin[part + 1];
 #pragma omp parallel for num_threads(threads_) schedule(static)
-      for (int32_t t = 0; t < n; ++t)
-        planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+        for (int32_t t = begin; t < end; ++t)
+          planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+      }
     }
     const FrameView frame_view{positions_.data(), planes_.data()};
-    const bvh::TreeView tree = tree_.view();
 
     std::vector<ThreadSink> sinks(static_cast<size_t>(threads_));
-#pragma omp parallel num_threads(threads_)
-    {
-      ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
-      // Neighbour pairs from their list: their boxes always overlap.
-      const auto neighbor_count = static_cast<int64_t>(topo.neighbor_pairs.size());
-#pragma omp for schedule(static) nowait
-      for (int64_t i = 0; i < neighbor_count; ++i) {
-        const auto [t, x] = topo.neighbor_pairs[i];
-        if (degenerate_flags[t] || degenerate_flags[x]) continue;
-        ++sink.candidates;
-        const uint32_t shared = topo.neighbor_shared[i];
-        test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
-      }
-      // The other candidates from the traversal: the leaves of each group of up to four
-      // consecutive positions walk the tree together (for_each_later_overlap_grouped), groups
-      // in leaf order; dynamic chunks because groups in dense regions cost more.
-      const int32_t level = bvh::group_level(tree.shape);
-      const int32_t first_group = bvh::CompleteTree::level_begin(level);
-      const int32_t last_group =
-          std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
-#pragma omp for schedule(dynamic, 64)
-      for (int32_t group = first_group; group < last_group; ++group) {
-        bvh::for_each_later_overlap_grouped(tree, group, [&](int32_t t, int32_t x) {
-          if (degenerate_flags[t] || degenerate_flags[x] ||
-              is_listed_neighbor(topo.triangles[t], topo.triangles[x], view.listed_vertex,
-                                 view.every_vertex_listed))
-            return;
-          ++sink.candidates;
-          test_candidate_pair<use>(frame_view, view, t, x, sink);
-        });
-      }
+    for (int32_t c : checks) {
+      const auto check_start = Clock::now();
+      const PartCheck check = topo.checks[c];
+      if (check.self())
+        detect_self<use>(check.a, frame_view, view, degenerate_flags, sinks);
+      else
+        detect_between<use>(check.a, check.b, frame_view, view, degenerate_flags, sinks);
+      frame.check_seconds.push_back(seconds_since(check_start));
     }
 
     std::vector<EdgeTriangleTask> hits;
@@ -170,16 +177,96 @@ class CpuBackend final : public Backend {
     return frame;
   }
 
-  mesh::MeshView mesh_view() const {
-    return {positions_.data(), topology_->triangles.data(), static_cast<int32_t>(positions_.size()),
-            topology_->triangle_count()};
+  /// A part against itself: its neighbour pairs from their list (their boxes always overlap),
+  /// then the other candidates from its tree. The leaves of each group of up to four
+  /// consecutive positions walk the tree together (for_each_later_overlap_grouped), groups in
+  /// leaf order; dynamic chunks because groups in dense regions cost more.
+  template <FilterUse use>
+  void detect_self(int32_t part, const FrameView& frame_view, const TopologyView& view,
+                   const std::vector<uint8_t>& degenerate_flags, std::vector<ThreadSink>& sinks) {
+    const Topology& topo = *topology_;
+    const int32_t base = topo.layout.triangle_begin[part];
+    if (topo.layout.triangle_begin[part + 1] == base) return;
+    const bvh::TreeView tree = trees_[part].view();
+    const int64_t neighbor_begin = topo.self_neighbors[2 * part];
+    const int64_t neighbor_end = topo.self_neighbors[2 * part + 1];
+#pragma omp parallel num_threads(threads_)
+    {
+      ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static) nowait
+      for (int64_t i = neighbor_begin; i < neighbor_end; ++i) {
+        const auto [t, x] = topo.neighbor_pairs[i];
+        if (degenerate_flags[t] || degenerate_flags[x]) continue;
+        ++sink.candidates;
+        const uint32_t shared = topo.neighbor_shared[i];
+        test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
+      }
+      const int32_t level = bvh::group_level(tree.shape);
+      const int32_t first_group = bvh::CompleteTree::level_begin(level);
+      const int32_t last_group =
+          std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+#pragma omp for schedule(dynamic, 64)
+      for (int32_t group = first_group; group < last_group; ++group) {
+        bvh::for_each_later_overlap_grouped(tree, group, [&](int32_t local_t, int32_t local_x) {
+          const int32_t t = base + local_t, x = base + local_x;
+          if (degenerate_flags[t] || degenerate_flags[x] ||
+              is_listed_neighbor(topo.triangles[t], topo.triangles[x], view.listed_vertex,
+                                 view.every_vertex_listed))
+            return;
+          ++sink.candidates;
+          test_candidate_pair<use>(frame_view, view, t, x, sink);
+        });
+      }
+    }
+  }
+
+  /// Two parts: the leaves of the larger one, in groups of up to four, each walk the other's
+  /// whole tree (for_each_overlap_grouped). The parts share no vertex, so there is no
+  /// neighbour list.
+  template <FilterUse use>
+  void detect_between(int32_t a, int32_t b, const FrameView& frame_view, const TopologyView& view,
+                      const std::vector<uint8_t>& degenerate_flags,
+                      std::vector<ThreadSink>& sinks) {
+    const Topology& topo = *topology_;
+    auto size = [&](int32_t p) {
+      return topo.layout.triangle_begin[p + 1] - topo.layout.triangle_begin[p];
+    };
+    if (size(a) == 0 || size(b) == 0) return;
+    if (size(a) < size(b)) std::swap(a, b);
+    const int32_t base_a = topo.layout.triangle_begin[a], base_b = topo.layout.triangle_begin[b];
+    const bvh::TreeView tree = trees_[a].view(), other = trees_[b].view();
+    const int32_t level = bvh::group_level(tree.shape);
+    const int32_t first_group = bvh::CompleteTree::level_begin(level);
+    const int32_t last_group =
+        std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+#pragma omp parallel num_threads(threads_)
+    {
+      ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
+#pragma omp for schedule(dynamic, 64)
+      for (int32_t group = first_group; group < last_group; ++group) {
+        bvh::for_each_overlap_grouped(tree, group, other, [&](int32_t local_t, int32_t local_x) {
+          const int32_t t = base_a + local_t, x = base_b + local_x;
+          if (degenerate_flags[t] || degenerate_flags[x]) return;
+          ++sink.candidates;
+          test_candidate_pair<use>(frame_view, view, t, x, sink);
+        });
+      }
+    }
+  }
+
+  /// Part p's triangles over the whole frame's positions: its tree's triangle ids are local.
+  mesh::MeshView part_view(int32_t part) const {
+    const int32_t begin = topology_->layout.triangle_begin[part];
+    const int32_t end = topology_->layout.triangle_begin[part + 1];
+    return {positions_.data(), topology_->triangles.data() + begin,
+            static_cast<int32_t>(positions_.size()), end - begin};
   }
 
   int threads_;
   const Topology* topology_ = nullptr;
   std::span<const geom::Vec3d> positions_;
   std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
-  bvh::Tree tree_;
+  std::vector<bvh::Tree> trees_;                 ///< per part
 };
 
 }  // namespace

@@ -55,10 +55,84 @@ void make_neighbor_pairs(Topology& topo) {
   }
 }
 
+/// Keeps the neighbour pairs of the parts checked against themselves and records each part's
+/// range. Pairs never join two parts, and sorted pairs of one part are contiguous, as its
+/// triangles are.
+void select_self_neighbors(Topology& topo) {
+  const int32_t parts = topo.part_count();
+  std::vector<uint8_t> self(static_cast<size_t>(parts), 0);
+  for (const PartCheck& c : topo.checks)
+    if (c.self()) self[c.a] = 1;
+  std::vector<std::array<int32_t, 2>> kept_pairs;
+  std::vector<uint8_t> kept_shared;
+  topo.self_neighbors.assign(2 * static_cast<size_t>(parts), 0);
+  size_t i = 0;
+  const size_t n = topo.neighbor_pairs.size();
+  for (int32_t p = 0; p < parts; ++p) {
+    const int32_t end = topo.layout.triangle_begin[p + 1];
+    topo.self_neighbors[2 * p] = static_cast<int64_t>(kept_pairs.size());
+    for (; i < n && topo.neighbor_pairs[i][0] < end; ++i)
+      if (self[p]) {
+        kept_pairs.push_back(topo.neighbor_pairs[i]);
+        kept_shared.push_back(topo.neighbor_shared[i]);
+      }
+    topo.self_neighbors[2 * p + 1] = static_cast<int64_t>(kept_pairs.size());
+  }
+  if (kept_pairs.size() != n) {
+    topo.neighbor_pairs = std::move(kept_pairs);
+    topo.neighbor_shared = std::move(kept_shared);
+  }
+}
+
 }  // namespace
 
 Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_count) {
+  PartLayout layout;
+  layout.triangle_begin = {0, static_cast<int32_t>(triangles.size())};
+  layout.vertex_begin = {0, vertex_count};
+  return make_scene_topology(triangles, vertex_count, std::move(layout), {PartCheck{0, 0}});
+}
+
+int32_t Topology::part_of(int32_t t) const {
+  const auto& begin = layout.triangle_begin;
+  return static_cast<int32_t>(std::upper_bound(begin.begin() + 1, begin.end() - 1, t) -
+                              (begin.begin() + 1));
+}
+
+Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t vertex_count,
+                             PartLayout layout, std::vector<PartCheck> checks) {
+  const int32_t parts = layout.part_count();
+  if (parts < 1 || layout.vertex_begin.size() != layout.triangle_begin.size() ||
+      layout.triangle_begin.front() != 0 || layout.vertex_begin.front() != 0 ||
+      layout.triangle_begin.back() != static_cast<int32_t>(triangles.size()) ||
+      layout.vertex_begin.back() != vertex_count ||
+      !std::is_sorted(layout.triangle_begin.begin(), layout.triangle_begin.end()) ||
+      !std::is_sorted(layout.vertex_begin.begin(), layout.vertex_begin.end()))
+    throw InternalError("scene topology: the part layout does not cover the mesh");
+  for (PartCheck& c : checks) {
+    if (c.a > c.b) std::swap(c.a, c.b);
+    if (c.a < 0 || c.b >= parts)
+      throw InternalError("scene topology: a check of part " + std::to_string(c.b) + " of " +
+                          std::to_string(parts));
+  }
+  std::sort(checks.begin(), checks.end(), [](const PartCheck& x, const PartCheck& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  });
+  checks.erase(std::unique(checks.begin(), checks.end()), checks.end());
+  for (int32_t p = 0; p < parts; ++p)
+    for (int32_t t = layout.triangle_begin[p]; t < layout.triangle_begin[p + 1]; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int32_t v = triangles[t].v[k];
+        if (v >= 0 && v < vertex_count &&
+            (v < layout.vertex_begin[p] || v >= layout.vertex_begin[p + 1]))
+          throw InternalError("scene topology: triangle " + std::to_string(t) + " of part " +
+                              std::to_string(p) + " uses vertex " + std::to_string(v) +
+                              " of another part");
+      }
+
   Topology topo;
+  topo.layout = std::move(layout);
+  topo.checks = std::move(checks);
   topo.triangles.assign(triangles.begin(), triangles.end());
   topo.vertex_count = vertex_count;
   const auto n = static_cast<int32_t>(triangles.size());
@@ -106,6 +180,7 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
   if (!records.empty())
     topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
   make_neighbor_pairs(topo);
+  select_self_neighbors(topo);
   return topo;
 }
 

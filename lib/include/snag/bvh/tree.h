@@ -33,10 +33,8 @@ SNAG_HD_INLINE void refit_internal(int32_t node, TreeView tree) {
   tree.boxes[node] = geom::merge(tree.boxes[2 * node + 1], tree.boxes[2 * node + 2]);
 }
 
-/// Calls visit(triangle) for every leaf after `position` (in leaf order) whose box overlaps
-/// the leaf at `position`, so that each unordered pair of leaves is visited once, from the
-/// earlier one. For every ancestor reached from a left child, the right sibling's subtree holds
-/// exactly the later leaves under that ancestor; each is walked depth-first without a stack.
+/// Walks the subtree under `root` depth-first without a stack: test(node) says whether a
+/// node's box overlaps what is searched for; at an overlapping leaf, at_leaf(leaf) is called.
 /// Memory: a few registers.
 ///
 /// The walk's next node is chosen without a data-dependent branch: the left child when the
@@ -45,28 +43,48 @@ SNAG_HD_INLINE void refit_internal(int32_t node, TreeView tree) {
 /// of t right children and stepping to the sibling is (j >> t) + 1 in 1-based terms, (j >> t)
 /// in 0-based ones, with t the number of trailing ones of j. The walk ends when that climb
 /// would reach the subtree's root.
+template <class Test, class AtLeaf>
+SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test,
+                                 AtLeaf&& at_leaf) {
+  const int32_t first_leaf = tree.shape.leaf_count - 1;
+  const int root_level = CompleteTree::level_of(root);
+  int32_t i = root;
+  while (true) {
+    const bool hit = test(i);
+    const bool internal = i < first_leaf;
+    if (hit & !internal) at_leaf(i);
+    const bool descend = hit & internal;
+    const uint32_t j = static_cast<uint32_t>(i) + 1;
+    const int climb = count_trailing_zeros(~j);
+    if (!descend & (climb >= floor_log2(j) - root_level)) break;
+    i = descend ? 2 * i + 1 : static_cast<int32_t>(j >> climb);
+  }
+}
+
+/// Calls visit(triangle) for every leaf after `position` (in leaf order) whose box overlaps
+/// the leaf at `position`, so that each unordered pair of leaves is visited once, from the
+/// earlier one. For every ancestor reached from a left child, the right sibling's subtree holds
+/// exactly the later leaves under that ancestor; each is walked (walk_subtree).
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
   const CompleteTree shape = tree.shape;
-  const int32_t first_leaf = shape.leaf_count - 1;
   const int32_t leaf = shape.leaf_at(position);
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
-    const int32_t root = node + 1;
-    const int root_level = CompleteTree::level_of(root);
-    int32_t i = root;
-    while (true) {
-      const bool hit = geom::overlap(box, tree.boxes[i]);
-      const bool internal = i < first_leaf;
-      if (hit & !internal) visit(tree.triangle_at[shape.position_of(i)]);
-      const bool descend = hit & internal;
-      const uint32_t j = static_cast<uint32_t>(i) + 1;
-      const int climb = count_trailing_zeros(~j);
-      if (!descend & (climb >= floor_log2(j) - root_level)) break;
-      i = descend ? 2 * i + 1 : static_cast<int32_t>(j >> climb);
-    }
+    walk_subtree(
+        tree, node + 1, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); },
+        [&](int32_t i) { visit(tree.triangle_at[shape.position_of(i)]); });
   }
+}
+
+/// Calls visit(triangle) for every leaf of `tree` whose box overlaps `box`: a query from
+/// another tree's leaf (two objects checked against each other).
+template <class Visit>
+SNAG_HD_INLINE void for_each_overlap(TreeView tree, const geom::Box3f& box, Visit&& visit) {
+  walk_subtree(
+      tree, 0, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); },
+      [&](int32_t i) { visit(tree.triangle_at[tree.shape.position_of(i)]); });
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
@@ -105,74 +123,90 @@ inline int32_t group_level(const CompleteTree& shape) {
   return shape.depth >= 2 ? shape.depth - 2 : 0;
 }
 
+/// The (up to four) leaves under node `group` of group_level() as SIMD lanes: their boxes and
+/// triangles, for walks that test every node against all of them at once (4-lane compares, as a
+/// GPU warp runs its leaves together). Absent lanes get an empty box and are masked out.
+struct LeafLanes {
+  typedef float Lanes __attribute__((vector_size(16)));
+  typedef int32_t Mask __attribute__((vector_size(16)));
+  Lanes lo[3], hi[3];
+  Mask present;
+  int32_t triangle[4] = {-1, -1, -1, -1};
+  int32_t leaf[4] = {-1, -1, -1, -1};
+  int32_t members = 0;  ///< 2..4 (1 when the whole tree is one leaf)
+
+  LeafLanes(const TreeView& tree, int32_t group) {
+    int32_t begin, end;
+    tree.shape.positions_under(group, begin, end);
+    members = end - begin;
+    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = Lanes{};
+    for (int lane = 0; lane < 4; ++lane) {
+      geom::Box3f box = geom::empty_box();
+      if (lane < members) {
+        leaf[lane] = tree.shape.leaf_at(begin + lane);
+        box = tree.boxes[leaf[lane]];
+        triangle[lane] = tree.triangle_at[begin + lane];
+      }
+      for (int k = 0; k < 3; ++k) {
+        lo[k][lane] = box.lo[k];
+        hi[k][lane] = box.hi[k];
+      }
+    }
+    // The empty box is not enough: a leaf box that reaches +-FLT_MAX on every axis
+    // (coordinates beyond the float range) overlaps it.
+    present = Mask{members > 0 ? -1 : 0, members > 1 ? -1 : 0, members > 2 ? -1 : 0,
+                   members > 3 ? -1 : 0};
+  }
+
+  Mask overlaps(const geom::Box3f& box) const {
+    return (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
+           (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) & present;
+  }
+
+  /// Walks `tree`'s subtree under `root` for all lanes at once, descending where any lane
+  /// overlaps; at a leaf, calls visit(lane triangle, leaf's triangle) for each overlapping lane.
+  template <class Visit>
+  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
+    Mask last{};
+    walk_subtree(
+        tree, root,
+        [&](int32_t i) {
+          last = overlaps(tree.boxes[i]);
+          return (last[0] | last[1] | last[2] | last[3]) != 0;
+        },
+        [&](int32_t i) {
+          const int32_t other = tree.triangle_at[tree.shape.position_of(i)];
+          for (int lane = 0; lane < 4; ++lane)
+            if (last[lane]) visit(triangle[lane], other);
+        });
+  }
+};
+
 /// The per-leaf query of for_each_later_overlap, run for the (up to four) leaves under node
 /// `group` of group_level() at once: calls visit(member_triangle, other_triangle) for every
 /// pair of a member and a later leaf whose boxes overlap, each unordered pair once. The
 /// members share every ancestor above the group, so their walks through the later subtrees
-/// are one walk that tests each node against the four member boxes with 4-lane compares and
-/// descends when any overlaps; at a leaf, each overlapping member gets the visit. Pairs of
-/// members are tested directly. Used by the CPU backend (four leaves per SIMD register, as a
-/// GPU warp runs its leaves together); memory: a few registers and the four boxes.
+/// are one walk (LeafLanes::walk). Pairs of members are tested directly. Used by the CPU
+/// backend; memory: a few registers and the four boxes.
 template <class Visit>
 inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
-  typedef float Lanes __attribute__((vector_size(16)));
-  typedef int32_t LaneMask __attribute__((vector_size(16)));
-  const CompleteTree shape = tree.shape;
-  const int32_t first_leaf = shape.leaf_count - 1;
-  int32_t begin, end;
-  shape.positions_under(group, begin, end);
-  const int32_t members = end - begin;  // 2..4 (1 when the whole tree is one leaf)
-  int32_t member_triangle[4] = {-1, -1, -1, -1};
-  // Member boxes by lane; absent lanes get an empty box that overlaps nothing.
-  Lanes lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = Lanes{};
-  for (int lane = 0; lane < 4; ++lane) {
-    geom::Box3f box = geom::empty_box();
-    if (lane < members) {
-      box = tree.boxes[shape.leaf_at(begin + lane)];
-      member_triangle[lane] = tree.triangle_at[begin + lane];
-    }
-    for (int k = 0; k < 3; ++k) {
-      lo[k][lane] = box.lo[k];
-      hi[k][lane] = box.hi[k];
-    }
-  }
-  // Lanes without a member: their empty box is not enough, since a leaf box that reaches
-  // +-FLT_MAX on every axis (coordinates beyond the float range) overlaps it.
-  const LaneMask present = {members > 0 ? -1 : 0, members > 1 ? -1 : 0, members > 2 ? -1 : 0,
-                            members > 3 ? -1 : 0};
-  // Pairs of members.
-  for (int a = 0; a < members; ++a)
-    for (int b = a + 1; b < members; ++b) {
-      const geom::Box3f& ba = tree.boxes[shape.leaf_at(begin + a)];
-      if (geom::overlap(ba, tree.boxes[shape.leaf_at(begin + b)]))
-        visit(member_triangle[a], member_triangle[b]);
-    }
+  const LeafLanes lanes(tree, group);
+  for (int a = 0; a < lanes.members; ++a)
+    for (int b = a + 1; b < lanes.members; ++b)
+      if (geom::overlap(tree.boxes[lanes.leaf[a]], tree.boxes[lanes.leaf[b]]))
+        visit(lanes.triangle[a], lanes.triangle[b]);
   // Members against the later subtrees: the right siblings of the group's left-child ancestors.
-  for (int32_t node = group; node > 0; node = (node - 1) >> 1) {
-    if (!(node & 1)) continue;
-    const int32_t root = node + 1;
-    const int root_level = CompleteTree::level_of(root);
-    int32_t i = root;
-    while (true) {
-      const geom::Box3f& box = tree.boxes[i];
-      const LaneMask overlaps = (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
-                                (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) &
-                                present;
-      const bool hit = (overlaps[0] | overlaps[1] | overlaps[2] | overlaps[3]) != 0;
-      const bool internal = i < first_leaf;
-      if (hit & !internal) {
-        const int32_t other = tree.triangle_at[shape.position_of(i)];
-        for (int lane = 0; lane < 4; ++lane)
-          if (overlaps[lane]) visit(member_triangle[lane], other);
-      }
-      const bool descend = hit & internal;
-      const uint32_t j = static_cast<uint32_t>(i) + 1;
-      const int climb = count_trailing_zeros(~j);
-      if (!descend & (climb >= floor_log2(j) - root_level)) break;
-      i = descend ? 2 * i + 1 : static_cast<int32_t>(j >> climb);
-    }
-  }
+  for (int32_t node = group; node > 0; node = (node - 1) >> 1)
+    if (node & 1) lanes.walk(tree, node + 1, visit);
+}
+
+/// for_each_overlap for the (up to four) leaves under node `group` of `tree` (group_level())
+/// against every leaf of `other`: calls visit(member_triangle, other_triangle) for every pair
+/// whose boxes overlap.
+template <class Visit>
+inline void for_each_overlap_grouped(TreeView tree, int32_t group, TreeView other, Visit&& visit) {
+  const LeafLanes lanes(tree, group);
+  lanes.walk(other, 0, visit);
 }
 
 /// Owning tree on the host (the CPU backend; the CUDA backend keeps device buffers instead).

@@ -26,6 +26,8 @@ struct FilteredFrame {
   int64_t filtered_tests = 0;
   double traverse_seconds = 0;
   double classify_seconds = 0;
+  /// Per check run (in the order asked), the seconds of its traversal and narrow phase.
+  std::vector<double> check_seconds;
 };
 
 /// Triangles of zero area as far as the filter can tell.
@@ -34,31 +36,72 @@ struct DegeneracyScan {
   std::vector<int32_t> uncertain;   ///< the filter cannot tell (sorted)
 };
 
+/// Every part of the topology, or every check: what the single-mesh calls below pass.
+inline std::vector<int32_t> all_indices(int32_t count) {
+  std::vector<int32_t> all(static_cast<size_t>(count));
+  for (int32_t i = 0; i < count; ++i) all[i] = i;
+  return all;
+}
+
+/// A backend works on one topology of one or more parts (topology.h): one tree per part,
+/// built, refit and measured part by part, and the topology's checks run as the caller picks
+/// them, so that a part that did not move costs nothing.
 class Backend {
  public:
   virtual ~Backend() = default;
   virtual std::string_view name() const = 0;
   /// A new topology, owned by the caller and valid until the next call.
   virtual void set_topology(const Topology& topology) = 0;
-  /// This frame's positions (vertex_count entries); valid until the next call.
-  virtual void set_positions(std::span<const geom::Vec3d> positions) = 0;
+  /// This frame's positions (vertex_count entries); valid until the next call. `moved[p]` is 0
+  /// for a part whose positions are the previous call's, bit for bit: a backend with memory of
+  /// its own copies only the other parts across. Empty: every part moved.
+  virtual void set_part_positions(std::span<const geom::Vec3d> positions,
+                                  std::span<const uint8_t> moved) = 0;
   /// The next frame's positions, given while the current one is checked, so that a backend
-  /// with memory of its own can copy them across meanwhile; a set_positions() with the same
-  /// span (same address and size, contents unchanged since) then copies nothing. A hint: the
-  /// CPU backend has nothing to copy, and a span never set is dropped.
-  virtual void stage_positions(std::span<const geom::Vec3d> next) { (void)next; }
-  virtual DegeneracyScan scan_degenerate() = 0;
-  /// Builds the tree over the current positions.
-  virtual void build() = 0;
-  /// Refits the tree to the current positions.
-  virtual void refit() = 0;
-  /// Sum of internal-node half areas over the root's half area (1 for a single triangle).
-  virtual double tree_quality() = 0;
-  /// Traversal and the narrow phase; `degenerate` (sorted) are left out. With
+  /// with memory of its own can copy them across meanwhile; a set_part_positions() with the
+  /// same span (same address and size, contents unchanged since) then copies nothing. A hint:
+  /// the CPU backend has nothing to copy, and a span never set is dropped. `moved` as in
+  /// set_part_positions, relative to the frame being checked.
+  virtual void stage_part_positions(std::span<const geom::Vec3d> next,
+                                    std::span<const uint8_t> moved) {
+    (void)next;
+    (void)moved;
+  }
+  /// Triangles of these parts of zero area as far as the filter can tell.
+  virtual DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) = 0;
+  /// Builds part p's tree over the current positions.
+  virtual void build_part(int32_t part) = 0;
+  /// Refits part p's tree to the current positions.
+  virtual void refit_part(int32_t part) = 0;
+  /// Part p's tree: sum of internal-node half areas over the root's half area (0 for a single
+  /// triangle).
+  virtual double part_quality(int32_t part) = 0;
+  /// Traversal and the narrow phase of the topology's checks listed in `checks` (indices into
+  /// Topology::checks, increasing); `degenerate` (sorted) are left out. With
   /// FilterUse::defer_all every edge-triangle test of every candidate pair is returned in
   /// `uncertain`, and `pairs` holds only duplicated faces (found by their ids).
-  virtual FilteredFrame detect(std::span<const int32_t> degenerate,
-                               FilterUse use = FilterUse::certify) = 0;
+  virtual FilteredFrame detect_checks(std::span<const int32_t> degenerate, FilterUse use,
+                                      std::span<const int32_t> checks) = 0;
+
+  // A single mesh (or every part and every check at once).
+  void set_positions(std::span<const geom::Vec3d> positions) { set_part_positions(positions, {}); }
+  void stage_positions(std::span<const geom::Vec3d> next) { stage_part_positions(next, {}); }
+  DegeneracyScan scan_degenerate() { return scan_degenerate_parts(all_indices(part_count())); }
+  void build() {
+    for (int32_t p = 0; p < part_count(); ++p) build_part(p);
+  }
+  void refit() {
+    for (int32_t p = 0; p < part_count(); ++p) refit_part(p);
+  }
+  /// The quality of the first part's tree: a single mesh's.
+  double tree_quality() { return part_quality(0); }
+  FilteredFrame detect(std::span<const int32_t> degenerate, FilterUse use = FilterUse::certify) {
+    return detect_checks(degenerate, use, all_indices(check_count()));
+  }
+
+ protected:
+  virtual int32_t part_count() const = 0;
+  virtual int32_t check_count() const = 0;
 };
 
 }  // namespace snag::detect

@@ -12,6 +12,7 @@
 #include "snag/detect/backend.h"
 #include "snag/detect/exact.h"
 #include "snag/detect/result.h"
+#include "snag/detect/topology.h"
 #include "snag/geom/vec3.h"
 
 namespace snag::detect {
@@ -26,6 +27,23 @@ struct CheckSettings {
   ExactMode exact = ExactMode::uncertain;
 };
 
+/// One frame handed to Checker::check.
+struct FrameInput {
+  /// vertex_count entries; valid during the call.
+  std::span<const geom::Vec3d> positions;
+  /// Per part: 0 when its positions are bit for bit those of the previous check(). Such a
+  /// part is not refit, scanned or uploaded again, and checks between parts that did not move
+  /// keep their previous pairs (CheckOutcome::reused). Empty: every part moved. Ignored for
+  /// the first frame of a topology.
+  std::span<const uint8_t> moved;
+  /// The frame the next check() will be given, when known: a GPU backend copies it across
+  /// while this frame is checked. It must stay valid and unchanged until that check() returns
+  /// (a different next frame is merely copied again). `next_moved`: as `moved`, relative to
+  /// `positions`.
+  std::span<const geom::Vec3d> next_positions;
+  std::span<const uint8_t> next_moved;
+};
+
 class Checker {
  public:
   /// `resolver` decides what the filter cannot (modes `uncertain`, `all`; `off` decides with
@@ -35,21 +53,29 @@ class Checker {
           CheckSettings settings = {}, std::shared_ptr<PairConfirmer> confirmer = nullptr);
   ~Checker();
 
-  /// Sets the triangles (indices into each frame's positions). Returns true when they differ
-  /// from the current ones, in which case the next check() builds a new tree.
+  /// Sets the triangles of one mesh (indices into each frame's positions), checked against
+  /// itself. Returns true when they differ from the current ones, in which case the next
+  /// check() builds a new tree.
   bool set_triangles(std::span<const geom::Tri> triangles, int32_t vertex_count);
 
-  /// Checks one frame. `positions` has vertex_count entries and must stay valid during the call.
-  /// Throws snag::InputError when a coordinate is NaN or infinite.
-  ///
-  /// `next_positions`, when given, are the frame the next check() will be given: a GPU backend
-  /// copies them across while this frame is checked. They must stay valid and unchanged until
-  /// that check() returns (a different next frame is merely copied again).
-  FrameResult check(std::span<const geom::Vec3d> positions,
-                    std::span<const geom::Vec3d> next_positions = {});
+  /// Sets a scene: several objects (parts) laid end to end as `layout` says, and the pairs of
+  /// parts to check (topology.h). Returns true when anything differs from the current scene;
+  /// then the next check() builds every part's tree.
+  bool set_scene(std::span<const geom::Tri> triangles, int32_t vertex_count, PartLayout layout,
+                 std::vector<PartCheck> checks);
 
-  int rebuild_count() const { return rebuilds_; }  ///< builds other than the first of each topology
-  int build_count() const { return builds_; }
+  /// Checks one frame. Throws snag::InputError when a coordinate of a part that moved is NaN
+  /// or infinite.
+  FrameResult check(const FrameInput& frame);
+  FrameResult check(std::span<const geom::Vec3d> positions,
+                    std::span<const geom::Vec3d> next_positions = {}) {
+    return check(FrameInput{positions, {}, next_positions, {}});
+  }
+
+  /// Tree builds beyond the first of each part of each topology.
+  int rebuild_count() const { return rebuilds_; }
+  int build_count() const { return builds_; }  ///< tree builds, every part's
+  const Topology* topology() const { return topology_.get(); }
   std::string_view backend_name() const { return backend_->name(); }
   const CheckSettings& settings() const { return settings_; }
 
@@ -58,9 +84,16 @@ class Checker {
   std::shared_ptr<ExactResolver> resolver_;
   std::shared_ptr<PairConfirmer> confirmer_;
   CheckSettings settings_;
-  std::unique_ptr<struct Topology> topology_;
-  bool needs_build_ = true;
-  double built_quality_ = 0;
+  std::unique_ptr<Topology> topology_;
+  /// Per part: its tree must be built at the next check(), and its quality after its last build.
+  std::vector<uint8_t> needs_build_;
+  std::vector<double> built_quality_;
+  /// The last checked frame's degenerate triangles and pairs, kept for the parts and checks of
+  /// a frame in which they did not move; `checked_` says whether there is a last frame.
+  std::vector<int32_t> last_degenerate_;
+  std::vector<FacePair> last_pairs_;
+  std::vector<double> last_quality_;
+  bool checked_ = false;
   int builds_ = 0;
   int rebuilds_ = 0;
 };

@@ -35,6 +35,25 @@ struct StageTimes {
   double total() const { return build + refit + traverse + exact + classify + confirm; }
 };
 
+/// One part (a scene's object) in one frame.
+struct PartOutcome {
+  bool moved = true;     ///< its positions differ from the previous frame's (or it is new)
+  bool rebuilt = false;  ///< its tree was (re)built this frame
+  double build_seconds = 0;
+  double refit_seconds = 0;  ///< 0 when it did not move: nothing to refit
+  double tree_quality = 0;
+};
+
+/// One check of a scene (a part against itself or two parts) in one frame.
+struct CheckOutcome {
+  int32_t part_a = 0;
+  int32_t part_b = 0;
+  int64_t pairs = 0;
+  /// Neither part moved: the pairs are the previous frame's, taken without checking.
+  bool reused = false;
+  double seconds = 0;  ///< traversal and narrow phase (exact decisions are in times.exact)
+};
+
 struct FrameResult {
   std::vector<FacePair> pairs;      ///< sorted by (a, b), no duplicates
   std::vector<int32_t> degenerate;  ///< zero-area triangles, sorted; left out of the search
@@ -43,10 +62,12 @@ struct FrameResult {
   /// Tests the filter did not certify, decided by the exact stage (with `--exact off`, by the
   /// rounded doubles: decisions outside the filter's error bound; with `all`, every test).
   int64_t uncertain_tests = 0;
-  int64_t confirmed_pairs = 0;      ///< pairs confirmed independently (`--exact all`)
-  bool rebuilt = false;             ///< the tree was (re)built for this frame
-  double tree_quality = 0;          ///< sum of internal-node half areas over the root's
+  int64_t confirmed_pairs = 0;  ///< pairs confirmed independently (`--exact all`)
+  bool rebuilt = false;         ///< a tree was (re)built for this frame
+  double tree_quality = 0;  ///< the first part's: sum of internal-node half areas over the root's
   StageTimes times;
+  std::vector<PartOutcome> parts;    ///< per part of the topology (one for a single mesh)
+  std::vector<CheckOutcome> checks;  ///< per check of the topology, in its order
 
   int64_t crossing_count() const {
     int64_t n = 0;

@@ -1,5 +1,6 @@
-// What is fixed per topology: triangles, unique edges, which triangles use each edge, and the
-// representative-triangle ownership of edges (Curtis, Tamstorf and Manocha 2008).
+// What is fixed per topology: triangles, unique edges, which triangles use each edge, the
+// representative-triangle ownership of edges (Curtis, Tamstorf and Manocha 2008), and for a
+// scene of several objects, which triangles are whose and which objects are checked together.
 #pragma once
 
 #include <array>
@@ -10,6 +11,24 @@
 #include "snag/geom/vec3.h"
 
 namespace snag::detect {
+
+/// A scene's objects as the checker sees them ("parts"): laid end to end in one mesh, part p
+/// owning triangles [triangle_begin[p], triangle_begin[p + 1]) and vertices
+/// [vertex_begin[p], vertex_begin[p + 1]). Parts share no vertex: faces of two objects share no
+/// topology. A single mesh is one part.
+struct PartLayout {
+  std::vector<int32_t> triangle_begin = {0, 0};  ///< part count + 1 entries, non-decreasing
+  std::vector<int32_t> vertex_begin = {0, 0};
+  int32_t part_count() const { return static_cast<int32_t>(triangle_begin.size()) - 1; }
+};
+
+/// Two parts checked against each other, a <= b; a == b checks the part's self-intersections.
+struct PartCheck {
+  int32_t a = 0;
+  int32_t b = 0;
+  bool self() const { return a == b; }
+  friend bool operator==(const PartCheck&, const PartCheck&) = default;
+};
 
 /// Edge k of a triangle joins corners k and (k + 1) % 3.
 struct Topology {
@@ -42,10 +61,29 @@ struct Topology {
   bool every_vertex_listed = true;
   static constexpr int32_t kMaxListedValence = 32;
 
+  /// The parts (one for a single mesh) and the checks between them, in increasing (a, b).
+  /// Neighbour pairs never join two parts (they share no vertex); those of part p's self
+  /// check are neighbor_pairs[self_neighbors[2 p] .. self_neighbors[2 p + 1]), an empty range
+  /// when p is not checked against itself (its pairs are then not listed at all).
+  PartLayout layout;
+  std::vector<PartCheck> checks = {PartCheck{}};
+  std::vector<int64_t> self_neighbors;
+
   int32_t triangle_count() const { return static_cast<int32_t>(triangles.size()); }
+  int32_t part_count() const { return layout.part_count(); }
+  /// The part triangle t belongs to.
+  int32_t part_of(int32_t t) const;
 };
 
+/// The topology of one mesh: one part, checked against itself.
 Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_count);
+
+/// The topology of a scene: `triangles` and the vertex count of every part laid end to end as
+/// `layout` says, and the part pairs to check. Throws InternalError for a layout that does not
+/// cover the triangles and vertices, a triangle using another part's vertex, or a check of a
+/// part that does not exist.
+Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t vertex_count,
+                             PartLayout layout, std::vector<PartCheck> checks);
 
 /// The ownership masks for a frame whose degenerate triangles (sorted ids) own nothing: each
 /// edge goes to its smallest non-degenerate incident triangle.
