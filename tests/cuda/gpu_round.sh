@@ -30,7 +30,7 @@ for step in "${steps[@]}"; do
       # quality, scan, narrow phase, expansion, the one-block finish, the growth and the
       # device-wide sorts of the large path).
       memcheck_filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
-      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*'
+      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*:CudaScene.*'
       for tool in memcheck racecheck; do
         filter=$memcheck_filter; [ $tool = racecheck ] && filter=$racecheck_filter
         timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
@@ -41,10 +41,16 @@ for step in "${steps[@]}"; do
     reports)
       # Every sample and shared-data file checked on both backends: the reports must agree.
       rm -rf /tmp/rep; mkdir -p /tmp/rep; n=0; bad=0
-      inputs=(samples/drape $(find "$SNAG_DATA_DIR" -name '*.ply' | sort))
+      # Each input is the arguments of one run: samples, data files, and scenes (an obstacle
+      # still and moving, groups split).
+      inputs=(samples/drape "samples/drape --obstacle samples/drape_sphere.obj"
+              "samples/drape/drape.%04d.obj --obstacle samples/drape/drape.%04d.obj"
+              $(find "$SNAG_DATA_DIR" -name '*.ply' | sort))
+      [ -f samples/drape-scene.json ] && inputs+=("--scene samples/drape-scene.json")
       for input in "${inputs[@]}"; do
         n=$((n+1))
-        for b in cpu cuda; do snag check "$input" --backend $b --out /tmp/rep/$n-$b --quiet >/dev/null 2>>"$out/reports.log"; echo "$input $b rc=$?" >>"$out/reports.log"; done
+        # shellcheck disable=SC2086  # an input is several arguments
+        for b in cpu cuda; do snag check $input --backend $b --out /tmp/rep/$n-$b --quiet >/dev/null 2>>"$out/reports.log"; echo "$input $b rc=$?" >>"$out/reports.log"; done
         python3 - "$input" /tmp/rep/$n-cpu /tmp/rep/$n-cuda >>"$out/reports.log" 2>&1 || bad=$((bad+1)) <<'PY'
 import json, sys, csv, io
 name, a, b = sys.argv[1:]
@@ -56,7 +62,7 @@ def report(d):
     j = json.load(open(d + '/report.json'))
     def strip(x):
         if isinstance(x, dict):
-            return {k: strip(v) for k, v in x.items() if k not in ('seconds', 'times', 'backend', 'threads', 'created', 'elapsed_seconds')}
+            return {k: strip(v) for k, v in x.items() if k not in ('seconds', 'times', 'backend', 'threads', 'created', 'elapsed_seconds') and not k.endswith('_seconds')}
         if isinstance(x, list):
             return [strip(v) for v in x]
         return x
