@@ -66,6 +66,7 @@ struct Meter {
   int32_t obstacle = 0;
   std::unique_ptr<measure::PenetrationMeter> meter;
   std::vector<int32_t> cloths;
+  bool fresh = true;  ///< made this frame, with its positions
 };
 
 /// One object's part of a scene frame, its own ids from 0.
@@ -263,8 +264,19 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             input.closed = why ? *why : "closed";
           }
           if (why) continue;
-          meters.push_back(
-              {obstacle, std::make_unique<measure::PenetrationMeter>(local, vertices), {}});
+          // A closed obstacle whose faces point inwards would measure its complement: its
+          // inside is the side of negative enclosed volume, so it is measured flipped.
+          const std::span<const geom::Vec3d> positions =
+              slice(mesh.positions, layout.vertex_begin, obstacle);
+          auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
+          meter->update_positions(positions, settings.threads);
+          if (meter->enclosed_volume() < 0) {
+            std::vector<geom::Tri> flipped = local;
+            for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
+            meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
+            meter->update_positions(positions, settings.threads);
+          }
+          meters.push_back({obstacle, std::move(meter), {}, true});
           at = meters.end() - 1;
         }
         at->cloths.push_back(cloth);
@@ -332,7 +344,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       std::vector<report::Penetration> penetration;
       for (Meter& m : meters) {
         const bool obstacle_moved = result.parts[m.obstacle].moved;
-        if (obstacle_moved)
+        if (obstacle_moved && !m.fresh)  // a fresh meter has this frame's positions
           m.meter->update_positions(slice(mesh.positions, layout.vertex_begin, m.obstacle),
                                     settings.threads);
         for (int32_t cloth : m.cloths) {
@@ -349,6 +361,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
           penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
                                  stats.max_depth, stats.mean_depth, stats.p95_depth});
         }
+        m.fresh = false;
       }
       std::sort(penetration.begin(), penetration.end(),
                 [](const report::Penetration& x, const report::Penetration& y) {

@@ -371,8 +371,13 @@ class CudaBackendImpl final : public CudaBackend {
                                                                        : part_[p].version;
     return versions;
   }
-  static bool same_moved(std::span<const uint8_t> a, const std::vector<uint8_t>& b) {
-    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin());
+  /// Whether two `moved` lists say the same of every part (an empty one: every part moved).
+  bool same_moved(std::span<const uint8_t> a, const std::vector<uint8_t>& b) const {
+    for (size_t p = 0; p < part_.size(); ++p) {
+      const bool in_a = a.empty() || a[p], in_b = b.empty() || b[p];
+      if (in_a != in_b) return false;
+    }
+    return true;
   }
 
   /// Copies into `slot` (through its pinned buffer) the vertices of every part whose version
