@@ -114,8 +114,23 @@ struct RunTotals {
   double wall_seconds = 0;
 };
 
+/// A scene run's objects, one line: "dress (cloth), body (obstacle, still, closed)".
+std::string objects_line(const std::vector<report::ObjectInput>& objects) {
+  std::string line;
+  for (const report::ObjectInput& o : objects) {
+    if (!line.empty()) line += ", ";
+    line += o.name + " (" + o.role;
+    if (o.still) line += ", still";
+    if (!o.closed.empty()) line += o.closed == "closed" ? ", closed" : ", not closed";
+    line += ")";
+  }
+  return line;
+}
+
 void print_summary(std::ostream& out, const report::Summary& s, const RunTotals& totals,
-                   const std::string& rebuild_policy, const std::string& out_dir) {
+                   const std::string& rebuild_policy, const std::string& out_dir,
+                   const report::Inputs& inputs) {
+  if (inputs.scene()) out << "objects              " << objects_line(inputs.objects) << "\n";
   out << "frames checked       " << s.frames_checked << "\n";
   out << "frames with crossing " << s.frames_with_crossings << "\n";
   out << "worst frame          ";
@@ -128,6 +143,10 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
   out << "pairs                " << s.pairs << " (" << s.crossing << " crossing, " << s.touching
       << " touching)\n";
   if (s.degenerate > 0) out << "degenerate faces     " << s.degenerate << "\n";
+  if (inputs.scene()) {
+    out << "reused pairs         " << s.reused_pairs << " (checks whose objects did not move)\n";
+    out << "deepest penetration  " << fixed(s.max_depth, 6) << "\n";
+  }
   const double per_frame = s.frames_checked > 0 ? s.check_seconds / s.frames_checked : 0.0;
   out << "time                 " << fixed(s.check_seconds, 3) << " s checking ("
       << fixed(per_frame * 1e3, 2) << " ms per frame), " << fixed(s.read_seconds, 3)
@@ -289,7 +308,7 @@ int run_check(const CheckOptions& o) {
   const report::Summary summary =
       reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
 
-  print_summary(std::cout, summary, totals, o.rebuild, o.out_dir);
+  print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs);
   std::cout.flush();
   if (summary.failed && !o.quiet)
     std::cerr << "snag: intersections found (--fail-on " << o.fail_on << "): exit status 1\n";
