@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::string sphere_path;
   int sphere_segments = 32;
+  double write_sphere_radius = std::nan("");
   int threads = 0;
   bool quiet = false;
   snag::samples::SceneParams scene;
@@ -156,6 +157,11 @@ int main(int argc, char** argv) {
   app.add_option("--sphere-segments", sphere_segments, "Segments around the written sphere")
       ->capture_default_str()
       ->check(CLI::Range(4, 4096));
+  app.add_option("--write-sphere-radius", write_sphere_radius,
+                 "Radius of the written sphere (default: --sphere-radius); a larger one, same "
+                 "centre, is an obstacle the cloth goes into")
+      ->type_name("R")
+      ->check(CLI::PositiveNumber);
   app.add_option("--threads", threads,
                  "OpenMP threads (0: OpenMP's default); the files do not depend on it")
       ->capture_default_str()
@@ -234,15 +240,17 @@ int main(int argc, char** argv) {
     }
 
     if (!sphere_path.empty()) {
-      const auto sphere =
-          snag::samples::make_sphere(scene.sphere_center, scene.sphere_radius, sphere_segments);
+      // Only the written mesh takes --write-sphere-radius; the simulation's sphere is unchanged.
+      const double radius =
+          std::isnan(write_sphere_radius) ? scene.sphere_radius : write_sphere_radius;
+      const auto sphere = snag::samples::make_sphere(scene.sphere_center, radius, sphere_segments);
       const std::filesystem::path path(sphere_path);
       if (path.has_parent_path()) {
         std::filesystem::create_directories(path.parent_path());
       }
       snag::samples::write_obj(path, sphere.positions, sphere.triangles, decimals,
-                               {"snag-cloth: sphere, radius " + fixed(scene.sphere_radius, 6) +
-                                ", " + std::to_string(sphere.triangles.size()) + " triangles"});
+                               {"snag-cloth: sphere, radius " + fixed(radius, 6) + ", " +
+                                std::to_string(sphere.triangles.size()) + " triangles"});
       std::cout << "sphere: " << sphere.triangles.size() << " triangles -> " << path.string()
                 << "\n";
     }
