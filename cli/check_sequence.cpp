@@ -69,16 +69,36 @@ struct Meter {
   bool fresh = true;  ///< made this frame, with its positions
 };
 
-/// One object's part of a scene frame, its own ids from 0.
-std::vector<geom::Tri> local_triangles(const scene::SceneFrame& frame, int32_t object) {
-  const int32_t first = frame.layout.triangle_begin[object];
-  const int32_t last = frame.layout.triangle_begin[object + 1];
-  const int32_t base = frame.layout.vertex_begin[object];
-  std::vector<geom::Tri> local(frame.mesh.triangles.begin() + first,
-                               frame.mesh.triangles.begin() + last);
+/// One object's part of the scene's (welded) triangles, its own vertex ids from 0.
+std::vector<geom::Tri> local_triangles(std::span<const geom::Tri> triangles,
+                                       const detect::PartLayout& layout, int32_t object) {
+  const int32_t base = layout.vertex_begin[object];
+  std::vector<geom::Tri> local(triangles.begin() + layout.triangle_begin[object],
+                               triangles.begin() + layout.triangle_begin[object + 1]);
   for (geom::Tri& t : local)
     for (int k = 0; k < 3; ++k) t.v[k] -= base;
   return local;
+}
+
+/// Why an obstacle is not closed, in the ids of its file: its triangles as the file numbers
+/// their vertices (an object of one group uses some of them), and, for a group, a word on
+/// how its triangles are counted.
+std::optional<std::string> why_obstacle_not_closed(const scene::SceneFrame& frame,
+                                                   std::span<const geom::Tri> local, int32_t object,
+                                                   bool group) {
+  const int32_t base = frame.layout.vertex_begin[object];
+  const int32_t vertices = frame.layout.vertex_begin[object + 1] - base;
+  if (frame.file_vertex.empty()) return measure::why_not_closed(local, vertices);
+  std::vector<geom::Tri> in_file(local.begin(), local.end());
+  int32_t file_vertices = 0;
+  for (geom::Tri& t : in_file)
+    for (int k = 0; k < 3; ++k) {
+      t.v[k] = frame.file_vertex[base + t.v[k]];
+      file_vertices = std::max(file_vertices, t.v[k] + 1);
+    }
+  std::optional<std::string> why = measure::why_not_closed(in_file, file_vertices);
+  if (why && group) *why += " (vertex ids are the file's; triangles are counted within the group)";
+  return why;
 }
 
 template <class T>
@@ -241,8 +261,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         any_weld = any_weld || representative[v] != v;
       if (!any_weld) representative.clear();
       file_triangles = mesh.triangles;
-      checker.set_scene(mesh::welded_triangles(mesh.triangles, representative),
-                        static_cast<int32_t>(mesh.positions.size()), layout, scene.checks);
+      const std::vector<geom::Tri> welded = mesh::welded_triangles(mesh.triangles, representative);
+      checker.set_scene(welded, static_cast<int32_t>(mesh.positions.size()), layout, scene.checks);
 
       // Penetration into each closed obstacle a cloth is checked against.
       meters.clear();
@@ -255,10 +275,12 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         auto at = std::find_if(meters.begin(), meters.end(),
                                [&](const Meter& m) { return m.obstacle == obstacle; });
         if (at == meters.end()) {
-          const std::vector<geom::Tri> local = local_triangles(scene_frame, obstacle);
+          // Closedness as the weld sees it: a body stored as a triangle soup can be welded.
+          const std::vector<geom::Tri> local = local_triangles(welded, layout, obstacle);
           const int32_t vertices =
               layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
-          const std::optional<std::string> why = measure::why_not_closed(local, vertices);
+          const std::optional<std::string> why = why_obstacle_not_closed(
+              scene_frame, local, obstacle, scene.objects[obstacle].spec.group.has_value());
           if (i == 0 && scene_report) {
             report::ObjectInput& input = inputs.objects[static_cast<size_t>(obstacle)];
             input.closed = why ? *why : "closed";

@@ -35,6 +35,8 @@ void append_object(SceneFrame& frame, const mesh::Mesh& file_mesh, const ObjectS
   if (!spec.group) {
     out.positions.insert(out.positions.end(), file_mesh.positions.begin(),
                          file_mesh.positions.end());
+    for (size_t v = 0; v < file_mesh.positions.size(); ++v)
+      frame.file_vertex.push_back(static_cast<int32_t>(v));
     std::vector<int32_t> group_map(file_mesh.group_names.size());
     for (size_t g = 0; g < group_map.size(); ++g)
       group_map[g] = scene_group(static_cast<int32_t>(g));
@@ -68,6 +70,7 @@ void append_object(SceneFrame& frame, const mesh::Mesh& file_mesh, const ObjectS
       if (local[v] == 0) {
         local[v] = next++;
         out.positions.push_back(file_mesh.positions[v]);
+        frame.file_vertex.push_back(static_cast<int32_t>(v));
       }
     const int32_t group = scene_group(
         file_mesh.triangle_group.empty() ? -1 : file_mesh.triangle_group[faces.front()]);

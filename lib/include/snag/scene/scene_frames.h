@@ -48,6 +48,8 @@ struct SceneFrame {
   /// Per triangle: its id in its object's file (an object of one group keeps the file's ids).
   /// Empty for a scene of one whole mesh, whose ids are the file's.
   std::vector<int32_t> file_triangle;
+  /// Per vertex: its id in its object's file (the same emptiness as file_triangle).
+  std::vector<int32_t> file_vertex;
   std::vector<std::string> files;  ///< per object, this frame's file
   std::vector<int64_t> polygons;   ///< per object, faces in its file
   bool any_assimp = false;         ///< some object's ids are assimp's
