@@ -102,4 +102,20 @@ struct BenchIoOptions {
 CLI::App* add_bench_io_command(CLI::App& bench, BenchIoOptions& options);
 int run_bench_io(const BenchIoOptions& options);
 
+/// Options of `snag bench scene`, filled by CLI11.
+struct BenchSceneOptions {
+  int size = 35992;
+  int obstacle_size = 50000;
+  int frames = 10;
+  int warmup = 2;
+  std::string backend = "both";
+  std::string generator;
+  int threads = 0;
+  int device = 0;
+};
+
+/// Adds the `scene` subcommand to `bench`; returns it.
+CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& options);
+int run_bench_scene(const BenchSceneOptions& options);
+
 }  // namespace snag::cli

@@ -43,6 +43,9 @@ int main(int argc, char** argv) {
     snag::cli::BenchIoOptions bench_io;
     CLI::App* bench_io_command =
         snag::cli::add_bench_io_command(*app.get_subcommand("bench"), bench_io);
+    snag::cli::BenchSceneOptions bench_scene;
+    CLI::App* bench_scene_command =
+        snag::cli::add_bench_scene_command(*app.get_subcommand("bench"), bench_scene);
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
@@ -54,6 +57,7 @@ int main(int argc, char** argv) {
     if (bench_gpu_command->parsed()) return snag::cli::run_bench_gpu(bench_gpu);
     if (bench_accuracy_command->parsed()) return snag::cli::run_bench_accuracy(bench_accuracy);
     if (bench_io_command->parsed()) return snag::cli::run_bench_io(bench_io);
+    if (bench_scene_command->parsed()) return snag::cli::run_bench_scene(bench_scene);
     throw snag::InternalError("no subcommand ran");
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.
