@@ -336,8 +336,12 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       record.tree_quality = result.tree_quality;
       record.times = result.times;
       const detect::Topology& topology = *checker.topology();
+      // A scene of one whole mesh has the file's ids (no table).
+      const auto file_id = [&](int32_t t) {
+        return scene_frame.file_triangle.empty() ? t : scene_frame.file_triangle[t];
+      };
       const auto group_name = [&](int32_t t) {
-        const int32_t g = mesh.triangle_group[t];
+        const int32_t g = mesh.triangle_group.empty() ? -1 : mesh.triangle_group[t];
         return g < 0 ? std::string("default") : mesh.group_names[g];
       };
       std::vector<report::CheckFrame> checks;
@@ -346,16 +350,14 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       for (const detect::FacePair& p : result.pairs) {
         const int32_t oa = topology.part_of(p.a), ob = topology.part_of(p.b);
         if (ignored(scene, oa, group_name(p.a), ob, group_name(p.b))) continue;
-        record.pairs.push_back({scene_frame.file_triangle[p.a], scene_frame.file_triangle[p.b],
-                                p.kind, mesh.source_polygon[p.a], mesh.source_polygon[p.b], oa,
-                                ob});
+        record.pairs.push_back({file_id(p.a), file_id(p.b), p.kind, mesh.source_polygon[p.a],
+                                mesh.source_polygon[p.b], oa, ob});
         for (report::CheckFrame& c : checks)
           if (c.object_a == oa && c.object_b == ob) ++c.pairs;
       }
       std::sort(record.pairs.begin(), record.pairs.end(), report::pair_order);
       for (int32_t t : result.degenerate)
-        record.degenerate.push_back(
-            {scene_frame.file_triangle[t], mesh.source_polygon[t], topology.part_of(t)});
+        record.degenerate.push_back({file_id(t), mesh.source_polygon[t], topology.part_of(t)});
       record.checks = std::move(checks);
       for (int32_t o = 0; o < object_count; ++o) {
         const detect::PartOutcome& part = result.parts[o];
