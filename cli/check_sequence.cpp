@@ -328,13 +328,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       record.vertices = static_cast<int32_t>(mesh.positions.size());
       record.triangles = static_cast<int32_t>(mesh.triangles.size());
       for (int64_t p : scene_frame.polygons) record.polygons += p;
-      record.candidate_pairs = result.candidate_pairs;
-      record.filtered_tests = result.filtered_tests;
-      record.uncertain_tests = result.uncertain_tests;
-      record.confirmed_pairs = result.confirmed_pairs;
-      record.rebuilt = result.rebuilt;
-      record.tree_quality = result.tree_quality;
-      record.times = result.times;
+      report::copy_check_counts(result, record);
       const detect::Topology& topology = *checker.topology();
       // A scene of one whole mesh has the file's ids (no table).
       const auto file_id = [&](int32_t t) {

@@ -71,9 +71,7 @@ namespace {
 int64_t check_of(const Topology& topology, const FacePair& p) {
   if (topology.checks.size() == 1) return 0;
   const PartCheck check{topology.part_of(p.a), topology.part_of(p.b)};
-  const auto at = std::lower_bound(
-      topology.checks.begin(), topology.checks.end(), check,
-      [](const PartCheck& x, const PartCheck& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  const auto at = std::lower_bound(topology.checks.begin(), topology.checks.end(), check);
   return at != topology.checks.end() && *at == check ? at - topology.checks.begin() : -1;
 }
 

@@ -201,10 +201,8 @@ class CpuBackend final : public Backend {
         const uint32_t shared = topo.neighbor_shared[i];
         test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
       }
-      const int32_t level = bvh::group_level(tree.shape);
-      const int32_t first_group = bvh::CompleteTree::level_begin(level);
-      const int32_t last_group =
-          std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+      int32_t first_group, last_group;
+      bvh::group_range(tree.shape, first_group, last_group);
 #pragma omp for schedule(dynamic, 64)
       for (int32_t group = first_group; group < last_group; ++group) {
         bvh::for_each_later_overlap_grouped(tree, group, [&](int32_t local_t, int32_t local_x) {
@@ -235,10 +233,8 @@ class CpuBackend final : public Backend {
     if (size(a) < size(b)) std::swap(a, b);
     const int32_t base_a = topo.layout.triangle_begin[a], base_b = topo.layout.triangle_begin[b];
     const bvh::TreeView tree = trees_[a].view(), other = trees_[b].view();
-    const int32_t level = bvh::group_level(tree.shape);
-    const int32_t first_group = bvh::CompleteTree::level_begin(level);
-    const int32_t last_group =
-        std::min(bvh::CompleteTree::level_begin(level + 1), tree.shape.node_count());
+    int32_t first_group, last_group;
+    bvh::group_range(tree.shape, first_group, last_group);
 #pragma omp parallel num_threads(threads_)
     {
       ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];

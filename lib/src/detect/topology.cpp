@@ -115,9 +115,7 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
       throw InternalError("scene topology: a check of part " + std::to_string(c.b) + " of " +
                           std::to_string(parts));
   }
-  std::sort(checks.begin(), checks.end(), [](const PartCheck& x, const PartCheck& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
-  });
+  std::sort(checks.begin(), checks.end());
   checks.erase(std::unique(checks.begin(), checks.end()), checks.end());
   for (int32_t p = 0; p < parts; ++p)
     for (int32_t t = layout.triangle_begin[p]; t < layout.triangle_begin[p + 1]; ++t)

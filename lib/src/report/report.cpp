@@ -79,6 +79,11 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
   std::sort(record.degenerate.begin(), record.degenerate.end(), [](const Face& x, const Face& y) {
     return x.object != y.object ? x.object < y.object : x.face < y.face;
   });
+  copy_check_counts(result, record);
+  return record;
+}
+
+void copy_check_counts(const detect::FrameResult& result, FrameRecord& record) {
   record.candidate_pairs = result.candidate_pairs;
   record.filtered_tests = result.filtered_tests;
   record.uncertain_tests = result.uncertain_tests;
@@ -86,7 +91,6 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
   record.rebuilt = result.rebuilt;
   record.tree_quality = result.tree_quality;
   record.times = result.times;
-  return record;
 }
 
 void SummaryAccumulator::add(const FrameRecord& frame) {

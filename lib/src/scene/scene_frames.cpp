@@ -136,10 +136,7 @@ ResolvedScene resolve_scene(const Scene& scene, std::string_view frame_selection
   }
   for (int i : scene.self_checks()) resolved.checks.push_back({i, i});
   for (const auto& [a, b] : scene.cross_checks()) resolved.checks.push_back({a, b});
-  std::sort(resolved.checks.begin(), resolved.checks.end(),
-            [](const detect::PartCheck& x, const detect::PartCheck& y) {
-              return x.a != y.a ? x.a < y.a : x.b < y.b;
-            });
+  std::sort(resolved.checks.begin(), resolved.checks.end());
   return resolved;
 }
 

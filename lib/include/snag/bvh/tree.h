@@ -4,6 +4,7 @@
 // inverse): about 52 (56) bytes per triangle.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -121,6 +122,13 @@ SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t bloc
 /// node is internal and holds 2 to 4 leaves (those of levels D - 1 and D below it).
 inline int32_t group_level(const CompleteTree& shape) {
   return shape.depth >= 2 ? shape.depth - 2 : 0;
+}
+
+/// The nodes of group_level(): [first, last), in leaf order.
+inline void group_range(const CompleteTree& shape, int32_t& first, int32_t& last) {
+  const int32_t level = group_level(shape);
+  first = CompleteTree::level_begin(level);
+  last = std::min(CompleteTree::level_begin(level + 1), shape.node_count());
 }
 
 /// The (up to four) leaves under node `group` of group_level() as SIMD lanes: their boxes and

@@ -27,7 +27,8 @@ struct PartCheck {
   int32_t a = 0;
   int32_t b = 0;
   bool self() const { return a == b; }
-  friend bool operator==(const PartCheck&, const PartCheck&) = default;
+  /// Ordered by (a, b), the order of Topology::checks.
+  friend auto operator<=>(const PartCheck&, const PartCheck&) = default;
 };
 
 /// Edge k of a triangle joins corners k and (k + 1) % 3.

@@ -120,6 +120,10 @@ struct FrameRecord {
   int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
 };
 
+/// Copies a checker's counts, rebuild, tree quality and stage times into `record` (what every
+/// frame record takes from its result, single mesh or scene).
+void copy_check_counts(const detect::FrameResult& result, FrameRecord& record);
+
 /// Builds a frame record from a checker's result. `source_polygon[t]` is triangle t's face id
 /// in the file (Mesh::source_polygon, one entry per triangle).
 FrameRecord make_frame_record(int64_t frame, std::string file, const detect::FrameResult& result,
