@@ -225,6 +225,7 @@ TEST(CliStatus, HelpAndVersionExitZero) {
                                                {"bench", "cpu", "--help"},
                                                {"bench", "gpu", "--help"},
                                                {"bench", "io", "--help"},
+                                               {"bench", "scene", "--help"},
                                                {"--version"}}) {
     const RunResult r = run_snag(args, tmp.path());
     EXPECT_EQ(r.status, 0) << args[0] << "\n" << context(r);
@@ -320,6 +321,7 @@ TEST(CliHelp, AgreesWithTheManPage) {
       {"snag bench gpu", {"bench", "gpu", "--help"}},
       {"snag bench accuracy", {"bench", "accuracy", "--help"}},
       {"snag bench io", {"bench", "io", "--help"}},
+      {"snag bench scene", {"bench", "scene", "--help"}},
   };
   for (const auto& [heading, args] : commands) {
     const std::string section = man_section(man, heading);
