@@ -66,6 +66,7 @@ struct Meter {
   int32_t obstacle = 0;
   std::unique_ptr<measure::PenetrationMeter> meter;
   std::vector<int32_t> cloths;
+  std::vector<measure::Clearance> clearances;  ///< per cloth: what earlier frames proved
   bool fresh = true;  ///< made this frame, with its positions
 };
 
@@ -298,10 +299,11 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
             meter->update_positions(positions, settings.threads);
           }
-          meters.push_back({obstacle, std::move(meter), {}, true});
+          meters.push_back({obstacle, std::move(meter), {}, {}, true});
           at = meters.end() - 1;
         }
         at->cloths.push_back(cloth);
+        at->clearances.emplace_back();
       }
     }
     const double read_seconds = current.frame->read_seconds + seconds_since(read_started);
@@ -365,7 +367,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         if (obstacle_moved && !m.fresh)  // a fresh meter has this frame's positions
           m.meter->update_positions(slice(mesh.positions, layout.vertex_begin, m.obstacle),
                                     settings.threads);
-        for (int32_t cloth : m.cloths) {
+        for (size_t c = 0; c < m.cloths.size(); ++c) {
+          const int32_t cloth = m.cloths[c];
           const auto kept = std::find_if(last_penetration.begin(), last_penetration.end(),
                                          [&](const report::Penetration& p) {
                                            return p.cloth == cloth && p.obstacle == m.obstacle;
@@ -375,7 +378,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             continue;
           }
           const measure::PenetrationStats stats =
-              m.meter->measure(slice(mesh.positions, layout.vertex_begin, cloth), settings.threads);
+              m.meter->measure(slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c],
+                               settings.threads);
           penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
                                  stats.max_depth, stats.mean_depth, stats.p95_depth});
         }

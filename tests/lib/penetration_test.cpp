@@ -345,6 +345,60 @@ TEST(Penetration, MovingDeformingObstacleIsRefitAndMatchesReference) {
   }
 }
 
+TEST(Penetration, ClearanceSkipsOnlyPointsProvenOutside) {
+  // A torus that slides and swells, and points that drift (small steps, some large jumps
+  // across the surface): measured with a Clearance, every frame's depths equal measure()'s
+  // bit for bit, while far points are skipped.
+  Surface s = torus(1.0, 0.35, 40, 20);
+  PenetrationMeter meter = meter_for(s);
+  const std::vector<Vec3d> rest = s.positions;
+  std::vector<Vec3d> points = random_points(s, 3000, 51);
+  std::mt19937 rng(52);
+  std::uniform_real_distribution<double> step(-0.004, 0.004);
+  std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
+  Clearance clearance, clearance_two;
+  int64_t skipped = 0;
+  double previous_travel = 0.0;
+  for (int frame = 0; frame < 12; ++frame) {
+    if (frame > 0) {
+      const double f = frame / 12.0;
+      double moved = 0.0;
+      for (size_t i = 0; i < rest.size(); ++i) {
+        const Vec3d next = (1.0 + 0.05 * f) * rest[i] + Vec3d{0.03 * f, 0.0, -0.02 * f};
+        const Vec3d d = next - s.positions[i];
+        moved = std::max(moved, std::sqrt(geom::dot(d, d)));
+        s.positions[i] = next;
+      }
+      meter.update_positions(s.positions, 2);
+      EXPECT_DOUBLE_EQ(meter.travel() - previous_travel, moved);
+      previous_travel = meter.travel();
+      for (Vec3d& p : points) p = p + Vec3d{step(rng), step(rng), step(rng)};
+      for (int jump = 0; jump < 40; ++jump) {  // far enough to cross the tube's wall
+        Vec3d& p = points[pick(rng)];
+        p = p + Vec3d{10 * step(rng), 60 * step(rng), 10 * step(rng)};
+      }
+    }
+    const std::string what = "frame " + std::to_string(frame);
+    std::vector<double> expected, remembered, remembered_two;
+    const PenetrationStats full = meter.measure(points, 2, &expected);
+    const PenetrationStats stats = meter.measure(points, clearance, 1, &remembered);
+    meter.measure(points, clearance_two, 2, &remembered_two);
+    ASSERT_EQ(remembered, expected) << what;
+    ASSERT_EQ(remembered_two, expected) << what;
+    EXPECT_EQ(stats.inside, full.inside) << what;
+    EXPECT_EQ(stats.p95_depth, full.p95_depth) << what;
+    EXPECT_EQ(full.proven_outside, 0) << what;
+    if (frame == 0) EXPECT_EQ(stats.proven_outside, 0);
+    skipped += stats.proven_outside;
+    if (frame == 6) expect_matches_reference(meter, s, points, what + " (reference)");
+  }
+  // Most random points in the torus's box sit farther from the surface than they move.
+  EXPECT_GT(skipped, 11 * 3000 / 2);
+  // Given a list of another length, the clearance starts over.
+  points.resize(100);
+  EXPECT_EQ(meter.measure(points, clearance, 2).proven_outside, 0);
+}
+
 TEST(Penetration, InsideOutSurfaceHasNegativeVolume) {
   Surface s = cube();
   for (Vec3d& v : s.positions) v = v + Vec3d{5, -3, 2};  // the volume does not depend on where

@@ -254,10 +254,15 @@ struct Surface {
   const geom::Vec3d* vertex_normal;
 };
 
-/// Depth of p: its distance to the surface when strictly inside, else 0. The walk keeps the
-/// deferred (farther) children on a fixed stack: one entry per level at most, and the
-/// complete tree of at most 2^31 leaves has at most 32 levels.
-double depth_of(geom::Vec3d p, const Surface& s) {
+/// A point's distance to the surface, and its depth: the distance when strictly inside, else 0.
+struct Reading {
+  double distance;  ///< +inf when no triangle was reached (a non-finite point)
+  double depth;
+};
+
+/// The walk keeps the deferred (farther) children on a fixed stack: one entry per level at
+/// most, and the complete tree of at most 2^31 leaves has at most 32 levels.
+Reading read_point(geom::Vec3d p, const Surface& s) {
   struct Entry {
     int32_t node;
     double bound;
@@ -299,7 +304,8 @@ double depth_of(geom::Vec3d p, const Surface& s) {
     bound = stack[top].bound;
   }
   // On the surface: not inside. Not finite: no triangle was reached (a non-finite p).
-  if (!(best2 > 0.0 && best2 < std::numeric_limits<double>::infinity())) return 0.0;
+  if (!(best2 > 0.0 && best2 < std::numeric_limits<double>::infinity()))
+    return {std::sqrt(best2), 0.0};
   geom::Vec3d normal;
   if (best.feature == kFace) {
     normal = s.face_normal[best_triangle];
@@ -309,7 +315,8 @@ double depth_of(geom::Vec3d p, const Surface& s) {
   } else {
     normal = s.vertex_normal[s.triangles[best_triangle].v[best.feature - kVertex0]];
   }
-  return geom::dot(p - best.point, normal) < 0.0 ? std::sqrt(best2) : 0.0;
+  const double distance = std::sqrt(best2);
+  return {distance, geom::dot(p - best.point, normal) < 0.0 ? distance : 0.0};
 }
 
 int thread_count(int threads) {
@@ -340,8 +347,16 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
     throw InternalError("PenetrationMeter: " + std::to_string(obstacle_positions.size()) +
                         " obstacle positions, expected " + std::to_string(vertex_count_));
   threads = thread_count(threads);
-  positions_.assign(obstacle_positions.begin(), obstacle_positions.end());
   const auto n = static_cast<int32_t>(triangles_.size());
+  if (built_) {
+    double moved2 = 0.0;
+    for (int32_t v = 0; v < vertex_count_; ++v) {
+      const geom::Vec3d d = obstacle_positions[v] - positions_[v];
+      moved2 = std::max(moved2, geom::dot(d, d));
+    }
+    travel_ += std::sqrt(moved2);
+  }
+  positions_.assign(obstacle_positions.begin(), obstacle_positions.end());
   face_normal_.resize(triangles_.size());
   vertex_normal_.resize(positions_.size());
   const geom::Vec3d* p = positions_.data();
@@ -384,6 +399,18 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
 
 PenetrationStats PenetrationMeter::measure(std::span<const geom::Vec3d> points, int threads,
                                            std::vector<double>* depths) const {
+  return measure_points(points, nullptr, threads, depths);
+}
+
+PenetrationStats PenetrationMeter::measure(std::span<const geom::Vec3d> points,
+                                           Clearance& clearance, int threads,
+                                           std::vector<double>* depths) const {
+  return measure_points(points, &clearance, threads, depths);
+}
+
+PenetrationStats PenetrationMeter::measure_points(std::span<const geom::Vec3d> points,
+                                                  Clearance* clearance, int threads,
+                                                  std::vector<double>* depths) const {
   if (!built_) throw InternalError("PenetrationMeter::measure before update_positions");
   std::vector<double> own;
   std::vector<double>& depth = depths ? *depths : own;
@@ -394,11 +421,39 @@ PenetrationStats PenetrationMeter::measure(std::span<const geom::Vec3d> points, 
   const auto count = static_cast<int64_t>(points.size());
   const geom::Vec3d* point = points.data();
   double* out = depth.data();
+  if (clearance && clearance->reach.size() != points.size()) {
+    clearance->anchor.assign(points.begin(), points.end());
+    clearance->reach.assign(points.size(), -std::numeric_limits<double>::infinity());
+  }
+  geom::Vec3d* anchor = clearance ? clearance->anchor.data() : nullptr;
+  double* reach = clearance ? clearance->reach.data() : nullptr;
+  const double travel = travel_;
+  int64_t proven_outside = 0;
   // Dynamic chunks: points near the surface cost more than points far from it.
-#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 256)
-  for (int64_t i = 0; i < count; ++i) out[i] = depth_of(point[i], surface);
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 256) \
+    reduction(+ : proven_outside)
+  for (int64_t i = 0; i < count; ++i) {
+    if (reach) {
+      const geom::Vec3d d = point[i] - anchor[i];
+      if (std::sqrt(geom::dot(d, d)) + travel < reach[i]) {
+        ++proven_outside;
+        continue;  // out[i] stays 0
+      }
+    }
+    const Reading r = read_point(point[i], surface);
+    out[i] = r.depth;
+    if (reach) {
+      // Only an outside point at a positive, finite distance proves anything later; the
+      // margin covers the rounding of this distance and of the later movement sums.
+      anchor[i] = point[i];
+      reach[i] = r.depth == 0.0 && r.distance > 0.0 && std::isfinite(r.distance)
+                     ? r.distance * (1.0 - 1e-9) + travel
+                     : -std::numeric_limits<double>::infinity();
+    }
+  }
 
   PenetrationStats stats;
+  stats.proven_outside = proven_outside;
   stats.points = count;
   std::vector<double> inside;
   double sum = 0.0;
