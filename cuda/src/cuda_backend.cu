@@ -133,7 +133,7 @@ class CudaBackendImpl final : public CudaBackend {
     while (check_timers_.size() < topology.checks.size())
       check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
-                           initial_capacity_);
+                           initial_capacity_, initial_capacity_);
     stream_->synchronize();
   }
 
@@ -444,7 +444,8 @@ class CudaBackendImpl final : public CudaBackend {
   /// Result buffers for at least these counts. Never shrinks, so a sequence allocates only
   /// while its counts grow; the pair set's table is a power of two at least twice the pairs.
   void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates,
-                              uint64_t pairs) {
+                              uint64_t pairs, uint64_t listed) {
+    listed_.reserve(listed);
     hits_.reserve(hits);
     uncertain_.reserve(uncertain);
     duplicates_.reserve(duplicates);
@@ -497,6 +498,7 @@ class CudaBackendImpl final : public CudaBackend {
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
   PinnedBuffer<FrameCounters> counters_host_;
+  DeviceBuffer<uint64_t> listed_;  // a check's candidate pairs, from its walk to its tests
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
@@ -592,6 +594,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     results.edge_face_offsets = topo_.edge_face_offsets.data();
     PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
                 pair_keys_.capacity()};
+    const CandidateList listed{listed_.data(), listed_.capacity()};
     HostResults out = host_results_;
     out.limit = finish_limit_;
     SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
@@ -601,19 +604,21 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     for (size_t i = 0; i < checks.size(); ++i) {
       const detect::PartCheck check = topology_->checks[checks[i]];
       if (time_each) check_timers_[i]->start(s);
+      // Each check lists its candidates from the start of the list.
+      SNAG_CUDA_CHECK(cudaMemsetAsync(&counters_.data()->listed, 0, sizeof(unsigned long long), s));
       if (check.self()) {
         const int64_t first = topology_->self_neighbors[2 * check.a];
         const int64_t count = topology_->self_neighbors[2 * check.a + 1] - first;
         if (part_size(check.a) > 0)
-          launch_narrow_phase(trees_[check.a]->view(), part_begin(check.a), inputs,
-                              topo_.neighbor_pairs.data() + first,
-                              topo_.neighbor_shared.data() + first, count, results, use, s);
+          launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs,
+                            topo_.neighbor_pairs.data() + first,
+                            topo_.neighbor_shared.data() + first, count, listed, results, use, s);
       } else {
         // One thread per leaf of the larger part, walking the smaller one's tree.
         const bool a_larger = part_size(check.a) >= part_size(check.b);
         const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
-        launch_cross_phase(trees_[big]->view(), part_begin(big), trees_[small]->view(),
-                           part_begin(small), inputs, results, use, s);
+        launch_cross_check(trees_[big]->view(), part_begin(big), trees_[small]->view(),
+                           part_begin(small), inputs, listed, results, use, s);
       }
       if (time_each) check_timers_[i]->stop_async(s);
     }
@@ -628,11 +633,12 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     timer_.elapsed();  // the wait
     c = *host_counters;
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
-        c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity())
+        c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
+        c.listed_most <= listed_.capacity())
       break;
     // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits.
     ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
-                           grown(c.expanded + c.duplicates));
+                           grown(c.expanded + c.duplicates), grown(c.listed_most));
     timer_.start(s);
   }
   collect_times();
@@ -726,13 +732,16 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     // Next frames start with this one's counts and some slack, so that creeping counts
     // rarely run a frame twice. Only now: growing discards the buffers' contents.
     const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain),
-                   duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates);
+                   duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates),
+                   listed = grown(c.listed_most);
     if (hits > hits_.capacity() || uncertain > uncertain_.capacity() ||
-        duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity())
+        duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity() ||
+        listed > listed_.capacity())
       ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()),
                              std::max<uint64_t>(uncertain, uncertain_.capacity()),
                              std::max<uint64_t>(duplicates, duplicates_.capacity()),
-                             std::max<uint64_t>(pairs, pair_keys_.capacity()));
+                             std::max<uint64_t>(pairs, pair_keys_.capacity()),
+                             std::max<uint64_t>(listed, listed_.capacity()));
   }
   return frame;
 }

@@ -87,26 +87,21 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
-/// One thread's share of the neighbour pass: listed pair i (their boxes always overlap).
-template <detect::FilterUse use>
-__device__ __forceinline__ void neighbor_pair(const PairInputs& in,
-                                              const std::array<int32_t, 2>* pairs,
-                                              const uint8_t* shared_masks, int64_t i,
-                                              DeviceSink& sink, unsigned long long& candidates) {
-  const int32_t t = pairs[i][0], x = pairs[i][1];
-  if (in.degenerate[t] || in.degenerate[x]) return;
-  ++candidates;
-  const uint32_t shared = shared_masks[i];
-  detect::test_pair<use>(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
+/// Lists the pair (t, x) for the pair tests.
+__device__ __forceinline__ void list_pair(const CandidateList& listed, FrameCounters* counters,
+                                          int32_t t, int32_t x) {
+  append(listed.pairs, listed.capacity, &counters->listed, pack(t, x));
 }
 
-/// One thread's share of the traversal: the leaf at `position`, so that a warp's triangles are
-/// neighbours and follow nearly the same path; pairs of the neighbour list are skipped.
-/// The tree's triangle ids are its part's: `base` is the part's first triangle.
-template <detect::FilterUse use>
-__device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, int32_t base,
-                                              const PairInputs& in, int32_t position,
-                                              DeviceSink& sink, unsigned long long& candidates) {
+/// A part's walk: the leaf at `position` (so that a warp's triangles are neighbours and follow
+/// nearly the same path) against the later leaves; degenerate triangles and pairs of the
+/// neighbour list (tested from the list) are left out. The tree's triangle ids are its part's:
+/// `base` is the part's first triangle.
+__global__ void __launch_bounds__(kNarrowBlock)
+    self_walk_kernel(bvh::TreeView tree, int32_t base, PairInputs in, CandidateList listed,
+                     FrameCounters* counters) {
+  const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (position >= tree.shape.leaf_count) return;
   const int32_t t = base + tree.triangle_at[position];
   if (in.degenerate[t]) return;
   const geom::Tri tt = in.topology.triangles[t];
@@ -116,53 +111,53 @@ __device__ __forceinline__ void traverse_leaf(const bvh::TreeView& tree, int32_t
         detect::is_listed_neighbor(tt, in.topology.triangles[x], in.topology.listed_vertex,
                                    in.topology.every_vertex_listed))
       return;
-    ++candidates;
-    detect::test_candidate_pair<use>(in.frame, in.topology, t, x, sink);
+    list_pair(listed, counters, t, x);
   });
 }
 
-/// Blocks [0, traverse_blocks) traverse, the rest run the neighbour pass (the branch is uniform
-/// per block). Small blocks (kNarrowBlock) spread the traversal's few threads per SM evenly.
-template <detect::FilterUse use>
+/// Two parts' walk: the leaf at `position` of `tree` (part a) against every leaf of `other`.
 __global__ void __launch_bounds__(kNarrowBlock)
-    narrow_phase_kernel(bvh::TreeView tree, int32_t base, PairInputs in,
-                        const std::array<int32_t, 2>* pairs, const uint8_t* shared_masks,
-                        int64_t pair_count, unsigned traverse_blocks, ResultBuffers out) {
-  DeviceSink sink{out};
-  unsigned long long candidates = 0;
-  if (blockIdx.x < traverse_blocks) {
-    const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-    if (position < tree.shape.leaf_count)
-      traverse_leaf<use>(tree, base, in, position, sink, candidates);
-  } else {
-    const int64_t i = static_cast<int64_t>(blockIdx.x - traverse_blocks) * blockDim.x + threadIdx.x;
-    if (i < pair_count) neighbor_pair<use>(in, pairs, shared_masks, i, sink, candidates);
-  }
-  add_warp_total(candidates, &out.counters->candidates);
-  add_warp_total(sink.misses, &out.counters->misses);
-  add_warp_total(sink.expanded, &out.counters->expanded);
+    cross_walk_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other, int32_t base_b,
+                      PairInputs in, CandidateList listed, FrameCounters* counters) {
+  const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (position >= tree.shape.leaf_count) return;
+  const int32_t t = base_a + tree.triangle_at[position];
+  if (in.degenerate[t]) return;
+  const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
+  bvh::for_each_overlap(other, box, [&](int32_t local_x) {
+    const int32_t x = base_b + local_x;
+    if (!in.degenerate[x]) list_pair(listed, counters, t, x);
+  });
 }
 
-/// Two parts: one thread per leaf of `tree` (part a, first triangle base_a), in leaf order,
-/// walking the whole of `other` (part b). Parts share no vertex: no shared corners, no
-/// neighbour list.
+/// The pair tests of one check: threads [0, neighbor_pair_count) take the pairs of the
+/// neighbour list (their boxes always overlap; shared corners stored), the next ones the pairs
+/// the walk listed (shared corners computed). The grid covers the list's capacity, so it is
+/// queued before the count is known; threads past the count do nothing.
 template <detect::FilterUse use>
-__global__ void __launch_bounds__(kNarrowBlock)
-    cross_phase_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other, int32_t base_b,
-                       PairInputs in, ResultBuffers out) {
+__global__ void __launch_bounds__(kBlock)
+    pair_test_kernel(PairInputs in, const std::array<int32_t, 2>* neighbor_pairs,
+                     const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+                     CandidateList listed, ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
-  const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (position < tree.shape.leaf_count) {
-    const int32_t t = base_a + tree.triangle_at[position];
-    if (!in.degenerate[t]) {
-      const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-      bvh::for_each_overlap(other, box, [&](int32_t local_x) {
-        const int32_t x = base_b + local_x;
-        if (in.degenerate[x]) return;
-        ++candidates;
-        detect::test_pair<use>(in.frame, in.topology, t, x, 0u, 0u, sink);
-      });
+  const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const unsigned long long listed_count = out.counters->listed;
+  if (i == 0) atomicMax(&out.counters->listed_most, listed_count);
+  if (i < neighbor_pair_count) {
+    const int32_t t = neighbor_pairs[i][0], x = neighbor_pairs[i][1];
+    if (!in.degenerate[t] && !in.degenerate[x]) {
+      ++candidates;
+      const uint32_t shared = neighbor_shared[i];
+      detect::test_pair<use>(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
+    }
+  } else {
+    const auto j = static_cast<unsigned long long>(i - neighbor_pair_count);
+    if (j < min(listed_count, listed.capacity)) {
+      const uint64_t pair = listed.pairs[j];
+      ++candidates;
+      detect::test_candidate_pair<use>(in.frame, in.topology, static_cast<int32_t>(pair >> 32),
+                                       static_cast<int32_t>(pair & 0xffffffffu), sink);
     }
   }
   add_warp_total(candidates, &out.counters->candidates);
@@ -296,34 +291,49 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
   launch(planes_kernel, n, stream, positions, triangles, n, planes);
 }
 
-void launch_narrow_phase(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs,
-                         const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream) {
-  const int64_t traverse_blocks =
-      tree.shape.leaf_count > 0 ? (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock : 0;
-  const int64_t blocks = traverse_blocks + (neighbor_pair_count + kNarrowBlock - 1) / kNarrowBlock;
-  if (blocks == 0) return;
-  const auto kernel = use == detect::FilterUse::certify
-                          ? narrow_phase_kernel<detect::FilterUse::certify>
-                          : narrow_phase_kernel<detect::FilterUse::defer_all>;
-  kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(
-      tree, base, inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count,
-      static_cast<unsigned>(traverse_blocks), results);
-  SNAG_CUDA_CHECK_LAUNCH();
+namespace {
+
+void launch_pair_tests(const PairInputs& inputs, const std::array<int32_t, 2>* neighbor_pairs,
+                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+                       const CandidateList& listed, const ResultBuffers& results,
+                       detect::FilterUse use, cudaStream_t stream) {
+  const auto items = neighbor_pair_count + static_cast<int64_t>(listed.capacity);
+  if (use == detect::FilterUse::certify)
+    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, neighbor_pairs,
+           neighbor_shared, neighbor_pair_count, listed, results);
+  else
+    launch(pair_test_kernel<detect::FilterUse::defer_all>, items, stream, inputs, neighbor_pairs,
+           neighbor_shared, neighbor_pair_count, listed, results);
 }
 
-void launch_cross_phase(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
-                        int32_t base_b, const PairInputs& inputs, const ResultBuffers& results,
-                        detect::FilterUse use, cudaStream_t stream) {
-  if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
-  const int64_t blocks = (tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock;
-  const auto kernel = use == detect::FilterUse::certify
-                          ? cross_phase_kernel<detect::FilterUse::certify>
-                          : cross_phase_kernel<detect::FilterUse::defer_all>;
-  kernel<<<static_cast<unsigned>(blocks), kNarrowBlock, 0, stream>>>(tree, base_a, other, base_b,
-                                                                     inputs, results);
+unsigned walk_blocks(const bvh::TreeView& tree) {
+  return static_cast<unsigned>((tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock);
+}
+
+}  // namespace
+
+void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
+                       const std::array<int32_t, 2>* neighbor_pairs,
+                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+                       const CandidateList& listed, const ResultBuffers& results,
+                       detect::FilterUse use, cudaStream_t stream) {
+  if (tree.shape.leaf_count <= 0) return;
+  // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
+  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs, listed,
+                                                                    results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
+  launch_pair_tests(inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count, listed, results,
+                    use, stream);
+}
+
+void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
+                        int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
+                        const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream) {
+  if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
+  cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
+      tree, base_a, other, base_b, inputs, listed, results.counters);
+  SNAG_CUDA_CHECK_LAUNCH();
+  launch_pair_tests(inputs, nullptr, nullptr, 0, listed, results, use, stream);
 }
 
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,

@@ -27,6 +27,18 @@ struct FrameCounters {
   unsigned long long degenerate;  ///< scan: certainly degenerate triangles
   unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
   unsigned long long pairs;  ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
+  unsigned long long listed;       ///< the current check's walk: candidate pairs it listed
+                                   ///< (zeroed before each check's walk)
+  unsigned long long listed_most;  ///< the most any check of the frame listed (entries wanted
+                                   ///< in the candidate list)
+};
+
+/// Where a check's walk lists its candidate pairs for the pair tests: (t << 32 | x) keys, t
+/// from the walking leaf's part, x from the tree walked, both topology ids. Past `capacity`
+/// only counters->listed moves.
+struct CandidateList {
+  uint64_t* pairs = nullptr;
+  unsigned long long capacity = 0;
 };
 
 /// The pairs of a frame as the expansion leaves them: distinct (a << bits | b) keys, a < b, in
@@ -98,22 +110,28 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream);
 
-/// A part against itself: the candidate pairs of the traversal of its tree (one thread per leaf
-/// position, in leaf order; the tree's triangle ids plus `base` are the topology's) and those
-/// of its neighbour list (one thread per pair), each through detect::test_candidate_pair: one
-/// launch, the traversal's blocks first (they run longest). With FilterUse::defer_all every
-/// test goes to the uncertain buffer (`--exact all`); a kernel of its own, so that the usual
-/// one carries no branch for it.
-void launch_narrow_phase(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                         const std::array<int32_t, 2>* neighbor_pairs,
-                         const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
-                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream);
+/// A part against itself, in two launches. The walk: one thread per leaf position of its tree
+/// (in leaf order; the tree's triangle ids plus `base` are the topology's), listing every
+/// later overlapping leaf that is neither degenerate nor a listed neighbour into `listed`,
+/// counted in results.counters->listed (which the caller zeroes first). The pair tests: one
+/// thread per pair of its neighbour list (detect::test_pair with the stored shared corners),
+/// then one per listed pair (detect::test_candidate_pair). Listing first keeps the walks short
+/// and even: a thread that tested its pairs in the walk held its warp's other walks back for
+/// each test, and the tests of a folded region's leaves piled onto a few warps. With
+/// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
+/// its own, so that the usual one carries no branch for it.
+void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
+                       const std::array<int32_t, 2>* neighbor_pairs,
+                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+                       const CandidateList& listed, const ResultBuffers& results,
+                       detect::FilterUse use, cudaStream_t stream);
 
-/// Two parts: one thread per leaf of `tree` (part a, whose first triangle is base_a) walking
-/// all of `other` (part b), each overlap through detect::test_pair (no shared corners).
-void launch_cross_phase(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
-                        int32_t base_b, const PairInputs& inputs, const ResultBuffers& results,
-                        detect::FilterUse use, cudaStream_t stream);
+/// Two parts, the same way: one thread per leaf of `tree` (part a, whose first triangle is
+/// base_a) listing the overlapping leaves of all of `other` (part b), then the pair tests of
+/// the list (parts share no vertex: no shared corners, no neighbour list).
+void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
+                        int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
+                        const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with

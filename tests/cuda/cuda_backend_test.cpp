@@ -450,8 +450,9 @@ TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
   }
 }
 
-TEST(CudaScene, ScenesMatchTheCpuAndBruteForceAsPartsMoveAndRest) {
-  SNAG_REQUIRE_GPU();
+/// A scene checked frame after frame on both backends; `capacity` > 0 starts the GPU's result
+/// buffers (its candidate list included) that small, so that checks overflow them and run again.
+void expect_scene_matches(int64_t capacity) {
   // A folded cloth, a lattice body and a second sheet, checked as a scene frame after frame:
   // the cloth moves every frame, the body never, the sheet in some; frames 6 and 7 are frozen.
   // Next frames are staged with what moves in them. Every frame's pairs, degenerate faces,
@@ -478,7 +479,9 @@ TEST(CudaScene, ScenesMatchTheCpuAndBruteForceAsPartsMoveAndRest) {
     moved.push_back(m);
   }
   auto resolver = std::make_shared<IntegerResolver>();
-  detect::Checker gpu(gpu_backend(), resolver), cpu(detect::make_cpu_backend(2), resolver);
+  std::unique_ptr<cuda::CudaBackend> backend = gpu_backend();
+  if (capacity > 0) backend->set_result_capacity(capacity);
+  detect::Checker gpu(std::move(backend), resolver), cpu(detect::make_cpu_backend(2), resolver);
   const auto vertices = static_cast<int32_t>(laid.mesh.positions.size());
   for (detect::Checker* c : {&gpu, &cpu})
     c->set_scene(laid.mesh.triangles, vertices, laid.layout, checks);
@@ -491,19 +494,29 @@ TEST(CudaScene, ScenesMatchTheCpuAndBruteForceAsPartsMoveAndRest) {
     const detect::FrameResult g = gpu.check(input);
     const detect::FrameResult c = cpu.check({frames[f], moved[f], {}, {}});
     SmallMesh frame_mesh{frames[f], laid.mesh.triangles};
-    EXPECT_EQ(g.pairs, c.pairs) << "frame " << f;
-    EXPECT_EQ(g.pairs, expected_pairs({frame_mesh, laid.layout}, checks)) << "frame " << f;
-    EXPECT_EQ(g.degenerate, c.degenerate) << "frame " << f;
-    EXPECT_EQ(g.candidate_pairs, c.candidate_pairs) << "frame " << f;
+    EXPECT_EQ(g.pairs, c.pairs) << "capacity " << capacity << " frame " << f;
+    EXPECT_EQ(g.pairs, expected_pairs({frame_mesh, laid.layout}, checks)) << "capacity " << capacity << " frame " << f;
+    EXPECT_EQ(g.degenerate, c.degenerate) << "capacity " << capacity << " frame " << f;
+    EXPECT_EQ(g.candidate_pairs, c.candidate_pairs) << "capacity " << capacity << " frame " << f;
     ASSERT_EQ(g.checks.size(), c.checks.size());
     for (size_t k = 0; k < g.checks.size(); ++k) {
-      EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs) << "frame " << f << " check " << k;
-      EXPECT_EQ(g.checks[k].reused, c.checks[k].reused) << "frame " << f << " check " << k;
+      EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs) << "capacity " << capacity << " frame " << f << " check " << k;
+      EXPECT_EQ(g.checks[k].reused, c.checks[k].reused) << "capacity " << capacity << " frame " << f << " check " << k;
     }
     for (size_t p = 0; p < g.parts.size(); ++p)
-      EXPECT_EQ(g.parts[p].tree_quality, c.parts[p].tree_quality) << "frame " << f;
+      EXPECT_EQ(g.parts[p].tree_quality, c.parts[p].tree_quality) << "capacity " << capacity << " frame " << f;
   }
   EXPECT_EQ(gpu.build_count(), 3);
+}
+
+TEST(CudaScene, ScenesMatchTheCpuAndBruteForceAsPartsMoveAndRest) {
+  SNAG_REQUIRE_GPU();
+  expect_scene_matches(0);
+}
+
+TEST(CudaScene, ScenesMatchWhenEveryBufferOverflows) {
+  SNAG_REQUIRE_GPU();
+  expect_scene_matches(1);
 }
 
 TEST(CudaBackend, BadDeviceIsAnError) {
