@@ -88,7 +88,6 @@ class CudaBackendImpl final : public CudaBackend {
     d.triangle_count = topology.triangle_count();
     d.vertex_count = topology.vertex_count;
     d.edge_count = static_cast<int32_t>(topology.edges.size());
-    d.neighbor_pair_count = static_cast<int64_t>(topology.neighbor_pairs.size());
     const size_t n = static_cast<size_t>(d.triangle_count);
     upload(d.triangles, topology.triangles.data(), n, s);
     upload(d.edges, topology.edges.data(), topology.edges.size(), s);
@@ -97,9 +96,6 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.edge_face_offsets, topology.edge_face_offsets.data(),
            topology.edge_face_offsets.size(), s);
     upload(d.edge_faces, topology.edge_faces.data(), topology.edge_faces.size(), s);
-    upload(d.listed_vertex, topology.listed_vertex.data(), topology.listed_vertex.size(), s);
-    upload(d.neighbor_pairs, topology.neighbor_pairs.data(), topology.neighbor_pairs.size(), s);
-    upload(d.neighbor_shared, topology.neighbor_shared.data(), topology.neighbor_shared.size(), s);
     d.frame_owned_edges.reserve(std::max<size_t>(n, 1));
     d.degenerate.reserve(std::max<size_t>(n, 1));
     d.degenerate_list.reserve(std::max<size_t>(n, 1));
@@ -568,8 +564,6 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   inputs.topology.edges = topo_.edges.data();
   inputs.topology.triangle_edges = topo_.triangle_edges.data();
   inputs.topology.owned_edges = owned;
-  inputs.topology.listed_vertex = topo_.listed_vertex.data();
-  inputs.topology.every_vertex_listed = topology_->every_vertex_listed;
   inputs.topology.triangle_count = n;
   inputs.topology.edge_count = topo_.edge_count;
   inputs.degenerate = topo_.degenerate.data();
@@ -607,12 +601,9 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
       // Each check lists its candidates from the start of the list.
       SNAG_CUDA_CHECK(cudaMemsetAsync(&counters_.data()->listed, 0, sizeof(unsigned long long), s));
       if (check.self()) {
-        const int64_t first = topology_->self_neighbors[2 * check.a];
-        const int64_t count = topology_->self_neighbors[2 * check.a + 1] - first;
         if (part_size(check.a) > 0)
-          launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs,
-                            topo_.neighbor_pairs.data() + first,
-                            topo_.neighbor_shared.data() + first, count, listed, results, use, s);
+          launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, listed, results,
+                            use, s);
       } else {
         // One thread per leaf of the larger part, walking the smaller one's tree.
         const bool a_larger = part_size(check.a) >= part_size(check.b);

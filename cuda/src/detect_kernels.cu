@@ -1,6 +1,7 @@
 #include "detect_kernels.cuh"
 
 #include <cooperative_groups.h>
+#include <cooperative_groups/scan.h>
 
 #include <cub/block/block_radix_sort.cuh>
 
@@ -87,77 +88,96 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
-/// Lists the pair (t, x) for the pair tests.
-__device__ __forceinline__ void list_pair(const CandidateList& listed, FrameCounters* counters,
-                                          int32_t t, int32_t x) {
-  append(listed.pairs, listed.capacity, &counters->listed, pack(t, x));
-}
+/// A walk's listing: its thread's pairs held in a small local array and appended to the list
+/// a chunk at a time, each chunk with one atomic per group of converged threads. Appending
+/// each pair on its own serialised the walks on the list's counter.
+class PairLister {
+ public:
+  static constexpr int kChunk = 16;
+
+  __device__ PairLister(const CandidateList& list, unsigned long long* counter)
+      : list_(list), counter_(counter) {}
+
+  __device__ __forceinline__ void add(uint64_t pair) {
+    held_[count_++] = pair;
+    if (count_ == kChunk) flush();
+  }
+
+  /// Appends what is held: the converged threads' counts summed across the group, one atomic.
+  __device__ void flush() {
+    const cg::coalesced_group group = cg::coalesced_threads();
+    const unsigned long long mine = static_cast<unsigned long long>(count_);
+    const unsigned long long before = cg::exclusive_scan(group, mine);
+    unsigned long long base = 0;
+    if (group.thread_rank() == group.size() - 1 && before + mine > 0)
+      base = atomicAdd(counter_, before + mine);
+    base = group.shfl(base, group.size() - 1) + before;
+    for (int k = 0; k < count_; ++k)
+      if (base + k < list_.capacity) list_.pairs[base + k] = held_[k];
+    count_ = 0;
+  }
+
+ private:
+  const CandidateList& list_;
+  unsigned long long* counter_;
+  uint64_t held_[kChunk];
+  int count_ = 0;
+};
 
 /// A part's walk: the leaf at `position` (so that a warp's triangles are neighbours and follow
-/// nearly the same path) against the later leaves; degenerate triangles and pairs of the
-/// neighbour list (tested from the list) are left out. The tree's triangle ids are its part's:
-/// `base` is the part's first triangle.
+/// nearly the same path) against the later leaves, listing (t, leaf node) for every overlap.
+/// Nothing is loaded at a leaf: degenerate triangles and shared corners are the pair tests'
+/// business, so the walk is box tests only. The pairs of the neighbour list (triangles that
+/// share a vertex, whose boxes always overlap) are among the listed ones, each once.
 __global__ void __launch_bounds__(kNarrowBlock)
-    self_walk_kernel(bvh::TreeView tree, int32_t base, PairInputs in, CandidateList listed,
-                     FrameCounters* counters) {
+    self_walk_kernel(bvh::TreeView tree, int32_t base, const uint8_t* degenerate,
+                     CandidateList listed, FrameCounters* counters) {
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   const int32_t t = base + tree.triangle_at[position];
-  if (in.degenerate[t]) return;
-  const geom::Tri tt = in.topology.triangles[t];
-  bvh::for_each_later_overlap(tree, position, [&](int32_t local_x) {
-    const int32_t x = base + local_x;
-    if (in.degenerate[x] ||
-        detect::is_listed_neighbor(tt, in.topology.triangles[x], in.topology.listed_vertex,
-                                   in.topology.every_vertex_listed))
-      return;
-    list_pair(listed, counters, t, x);
-  });
+  if (degenerate[t]) return;
+  PairLister lister(listed, &counters->listed);
+  bvh::for_each_later_overlapping_leaf(tree, position,
+                                       [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+  lister.flush();
 }
 
 /// Two parts' walk: the leaf at `position` of `tree` (part a) against every leaf of `other`.
 __global__ void __launch_bounds__(kNarrowBlock)
-    cross_walk_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other, int32_t base_b,
-                      PairInputs in, CandidateList listed, FrameCounters* counters) {
+    cross_walk_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other,
+                      const uint8_t* degenerate, CandidateList listed, FrameCounters* counters) {
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   const int32_t t = base_a + tree.triangle_at[position];
-  if (in.degenerate[t]) return;
+  if (degenerate[t]) return;
+  PairLister lister(listed, &counters->listed);
   const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-  bvh::for_each_overlap(other, box, [&](int32_t local_x) {
-    const int32_t x = base_b + local_x;
-    if (!in.degenerate[x]) list_pair(listed, counters, t, x);
-  });
+  bvh::for_each_overlapping_leaf(other, box, [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+  lister.flush();
 }
 
-/// The pair tests of one check: threads [0, neighbor_pair_count) take the pairs of the
-/// neighbour list (their boxes always overlap; shared corners stored), the next ones the pairs
-/// the walk listed (shared corners computed). The grid covers the list's capacity, so it is
-/// queued before the count is known; threads past the count do nothing.
+/// The pair tests of one check, one thread per listed (t, leaf of `walked`) pair: the leaf's
+/// triangle, `walked_base` added, is x; pairs with a degenerate triangle are left out, the
+/// others tested with their shared corners (detect::test_candidate_pair). The grid covers the
+/// list's capacity, so it is queued before the count is known; threads past the count do
+/// nothing.
 template <detect::FilterUse use>
 __global__ void __launch_bounds__(kBlock)
-    pair_test_kernel(PairInputs in, const std::array<int32_t, 2>* neighbor_pairs,
-                     const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+    pair_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
                      CandidateList listed, ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
-  const int64_t i = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const unsigned long long listed_count = out.counters->listed;
   if (i == 0) atomicMax(&out.counters->listed_most, listed_count);
-  if (i < neighbor_pair_count) {
-    const int32_t t = neighbor_pairs[i][0], x = neighbor_pairs[i][1];
-    if (!in.degenerate[t] && !in.degenerate[x]) {
+  if (i < min(listed_count, listed.capacity)) {
+    const uint64_t pair = listed.pairs[i];
+    const auto t = static_cast<int32_t>(pair >> 32);
+    const auto leaf = static_cast<int32_t>(pair & 0xffffffffu);
+    const int32_t x = walked_base + walked.triangle_at[walked.shape.position_of(leaf)];
+    if (!in.degenerate[x]) {
       ++candidates;
-      const uint32_t shared = neighbor_shared[i];
-      detect::test_pair<use>(in.frame, in.topology, t, x, shared & 7u, shared >> 3, sink);
-    }
-  } else {
-    const auto j = static_cast<unsigned long long>(i - neighbor_pair_count);
-    if (j < min(listed_count, listed.capacity)) {
-      const uint64_t pair = listed.pairs[j];
-      ++candidates;
-      detect::test_candidate_pair<use>(in.frame, in.topology, static_cast<int32_t>(pair >> 32),
-                                       static_cast<int32_t>(pair & 0xffffffffu), sink);
+      detect::test_candidate_pair<use>(in.frame, in.topology, t, x, sink);
     }
   }
   add_warp_total(candidates, &out.counters->candidates);
@@ -293,17 +313,16 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 
 namespace {
 
-void launch_pair_tests(const PairInputs& inputs, const std::array<int32_t, 2>* neighbor_pairs,
-                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
+void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, int32_t walked_base,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, cudaStream_t stream) {
-  const auto items = neighbor_pair_count + static_cast<int64_t>(listed.capacity);
+  const auto items = static_cast<int64_t>(listed.capacity);
   if (use == detect::FilterUse::certify)
-    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, neighbor_pairs,
-           neighbor_shared, neighbor_pair_count, listed, results);
+    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, walked,
+           walked_base, listed, results);
   else
-    launch(pair_test_kernel<detect::FilterUse::defer_all>, items, stream, inputs, neighbor_pairs,
-           neighbor_shared, neighbor_pair_count, listed, results);
+    launch(pair_test_kernel<detect::FilterUse::defer_all>, items, stream, inputs, walked,
+           walked_base, listed, results);
 }
 
 unsigned walk_blocks(const bvh::TreeView& tree) {
@@ -313,17 +332,14 @@ unsigned walk_blocks(const bvh::TreeView& tree) {
 }  // namespace
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const std::array<int32_t, 2>* neighbor_pairs,
-                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
-  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs, listed,
-                                                                    results.counters);
+  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs.degenerate,
+                                                                    listed, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_pair_tests(inputs, neighbor_pairs, neighbor_shared, neighbor_pair_count, listed, results,
-                    use, stream);
+  launch_pair_tests(inputs, tree, base, listed, results, use, stream);
 }
 
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
@@ -331,9 +347,9 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
   cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
-      tree, base_a, other, base_b, inputs, listed, results.counters);
+      tree, base_a, other, inputs.degenerate, listed, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_pair_tests(inputs, nullptr, nullptr, 0, listed, results, use, stream);
+  launch_pair_tests(inputs, other, base_b, listed, results, use, stream);
 }
 
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,

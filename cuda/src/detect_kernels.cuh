@@ -33,9 +33,9 @@ struct FrameCounters {
                                    ///< in the candidate list)
 };
 
-/// Where a check's walk lists its candidate pairs for the pair tests: (t << 32 | x) keys, t
-/// from the walking leaf's part, x from the tree walked, both topology ids. Past `capacity`
-/// only counters->listed moves.
+/// Where a check's walk lists its candidate pairs for the pair tests: (t << 32 | leaf) keys, t
+/// the walking leaf's triangle (a topology id), leaf a node of the tree walked. Past
+/// `capacity` only counters->listed moves.
 struct CandidateList {
   uint64_t* pairs = nullptr;
   unsigned long long capacity = 0;
@@ -111,24 +111,23 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
                    geom::PlaneCoefficients* planes, cudaStream_t stream);
 
 /// A part against itself, in two launches. The walk: one thread per leaf position of its tree
-/// (in leaf order; the tree's triangle ids plus `base` are the topology's), listing every
-/// later overlapping leaf that is neither degenerate nor a listed neighbour into `listed`,
-/// counted in results.counters->listed (which the caller zeroes first). The pair tests: one
-/// thread per pair of its neighbour list (detect::test_pair with the stored shared corners),
-/// then one per listed pair (detect::test_candidate_pair). Listing first keeps the walks short
-/// and even: a thread that tested its pairs in the walk held its warp's other walks back for
-/// each test, and the tests of a folded region's leaves piled onto a few warps. With
+/// (in leaf order; the tree's triangle ids plus `base` are the topology's), listing every later
+/// overlapping leaf into `listed`, counted in results.counters->listed (which the caller zeroes
+/// first). The pair tests: one thread per listed pair, through detect::test_candidate_pair
+/// (shared corners from the ids; degenerate triangles left out). The listed pairs are the CPU's
+/// neighbour pairs and traversal candidates together, each once: triangles that share a vertex
+/// always have overlapping boxes. Listing first keeps the walk to box tests (a walk that tested
+/// its pairs, or loaded anything at its leaves, held its warp's other walks back each time),
+/// and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
 /// its own, so that the usual one carries no branch for it.
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const std::array<int32_t, 2>* neighbor_pairs,
-                       const uint8_t* neighbor_shared, int64_t neighbor_pair_count,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, cudaStream_t stream);
 
 /// Two parts, the same way: one thread per leaf of `tree` (part a, whose first triangle is
 /// base_a) listing the overlapping leaves of all of `other` (part b), then the pair tests of
-/// the list (parts share no vertex: no shared corners, no neighbour list).
+/// the list (parts share no vertex: no shared corners).
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
                         int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
                         const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream);

@@ -1,9 +1,9 @@
-// The per-topology arrays on the device, uploaded once by set_topology: what the traversal,
-// the neighbour pass and the expansion of hits into face pairs read.
+// The per-topology arrays on the device, uploaded once by set_topology: what the pair tests
+// and the expansion of hits into face pairs read. The neighbour list of the CPU backend is not
+// among them: the GPU's walk lists neighbouring triangles with the rest (launch_self_check).
 //
 // Memory: triangles 12 B, triangle edges 12 B, ownership 2 x 1 B and degenerate flags 1 B per
-// triangle; edges 8 B and edge-face offsets 4 B per edge, 4 B per edge-face incidence; 1 B per
-// vertex (listed vertices); 8 B per neighbour pair.
+// triangle; edges 8 B and edge-face offsets 4 B per edge, 4 B per edge-face incidence.
 #pragma once
 
 #include <array>
@@ -24,14 +24,10 @@ struct DeviceTopology {
   DeviceBuffer<uint8_t> degenerate;         ///< per triangle: 1 when left out of this frame
   DeviceBuffer<int32_t> edge_face_offsets;
   DeviceBuffer<int32_t> edge_faces;
-  DeviceBuffer<uint8_t> listed_vertex;
-  DeviceBuffer<std::array<int32_t, 2>> neighbor_pairs;
-  DeviceBuffer<uint8_t> neighbor_shared;  ///< per neighbour pair: its shared-corner masks
   DeviceBuffer<int32_t> degenerate_list;  ///< upload area for a frame's degenerate ids
   int32_t triangle_count = 0;
   int32_t vertex_count = 0;
   int32_t edge_count = 0;
-  int64_t neighbor_pair_count = 0;
 };
 
 }  // namespace snag::cuda

@@ -62,30 +62,46 @@ SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test
   }
 }
 
-/// Calls visit(triangle) for every leaf after `position` (in leaf order) whose box overlaps
-/// the leaf at `position`, so that each unordered pair of leaves is visited once, from the
-/// earlier one. For every ancestor reached from a left child, the right sibling's subtree holds
-/// exactly the later leaves under that ancestor; each is walked (walk_subtree).
+/// Calls visit(leaf) with the node index of every leaf after `position` (in leaf order) whose
+/// box overlaps the leaf at `position`, so that each unordered pair of leaves is visited once,
+/// from the earlier one. For every ancestor reached from a left child, the right sibling's
+/// subtree holds exactly the later leaves under that ancestor; each is walked (walk_subtree).
+/// Nothing but boxes is read.
 template <class Visit>
-SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
-  const CompleteTree shape = tree.shape;
-  const int32_t leaf = shape.leaf_at(position);
+SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t position,
+                                                    Visit&& visit) {
+  const int32_t leaf = tree.shape.leaf_at(position);
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
     walk_subtree(
-        tree, node + 1, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); },
-        [&](int32_t i) { visit(tree.triangle_at[shape.position_of(i)]); });
+        tree, node + 1, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
   }
 }
 
-/// Calls visit(triangle) for every leaf of `tree` whose box overlaps `box`: a query from
-/// another tree's leaf (two objects checked against each other).
+/// for_each_later_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
+template <class Visit>
+SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
+  for_each_later_overlapping_leaf(tree, position, [&](int32_t leaf) {
+    visit(tree.triangle_at[tree.shape.position_of(leaf)]);
+  });
+}
+
+/// Calls visit(leaf) with the node index of every leaf of `tree` whose box overlaps `box`: a
+/// query from another tree's leaf (two objects checked against each other).
+template <class Visit>
+SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box,
+                                              Visit&& visit) {
+  walk_subtree(
+      tree, 0, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
+}
+
+/// for_each_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
 template <class Visit>
 SNAG_HD_INLINE void for_each_overlap(TreeView tree, const geom::Box3f& box, Visit&& visit) {
-  walk_subtree(
-      tree, 0, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); },
-      [&](int32_t i) { visit(tree.triangle_at[tree.shape.position_of(i)]); });
+  for_each_overlapping_leaf(tree, box, [&](int32_t leaf) {
+    visit(tree.triangle_at[tree.shape.position_of(leaf)]);
+  });
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
