@@ -237,17 +237,63 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
   }
 }
 
-using FinishPairSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItems, uint8_t>;
-using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kFinishItems>;
+template <int kItems>
+using FinishPairSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kItems, uint8_t>;
+template <int kItems>
+using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kItems>;
 
-/// Shared memory of finish_kernel: more than the static 48 KB, so it is dynamic.
-constexpr size_t kFinishShared = sizeof(typename FinishPairSort::TempStorage) >
-                                         sizeof(typename FinishTaskSort::TempStorage)
-                                     ? sizeof(typename FinishPairSort::TempStorage)
-                                     : sizeof(typename FinishTaskSort::TempStorage);
+/// Shared memory of finish_kernel: the largest sort's (more than the static 48 KB, so dynamic).
+constexpr size_t kFinishShared =
+    sizeof(typename FinishPairSort<kFinishItems>::TempStorage) >
+            sizeof(typename FinishTaskSort<kFinishItems>::TempStorage)
+        ? sizeof(typename FinishPairSort<kFinishItems>::TempStorage)
+        : sizeof(typename FinishTaskSort<kFinishItems>::TempStorage);
+
+/// Sorts `count` (at most kFinishThreads * kItems) pairs of the set by key into `out`.
+template <int kItems>
+__device__ void sort_pairs(const PairSet& set, unsigned long long count, int key_bits,
+                           const HostResults& out, unsigned char* shared) {
+  uint64_t keys[kItems];
+  uint8_t status[kItems];
+  for (int k = 0; k < kItems; ++k) {
+    const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kItems + k;
+    keys[k] = at < count ? set.keys[at] : kEmptyKey;  // the empty key sorts last
+    status[k] = at < count ? set.status[at] : 0;
+  }
+  using Sort = FinishPairSort<kItems>;
+  Sort(*reinterpret_cast<typename Sort::TempStorage*>(shared))
+      .SortBlockedToStriped(keys, status, 0, key_bits);
+  for (int k = 0; k < kItems; ++k) {
+    const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+    if (at < count) {
+      out.keys[at] = keys[k];
+      out.status[at] = status[k];
+    }
+  }
+  __syncthreads();  // the shared memory is the next sort's
+}
+
+/// Sorts `count` (at most kFinishThreads * kItems) uncertain tests into `out`.
+template <int kItems>
+__device__ void sort_tasks(const uint64_t* uncertain, unsigned long long count, int task_bits,
+                           const HostResults& out, unsigned char* shared) {
+  uint64_t keys[kItems];
+  for (int k = 0; k < kItems; ++k) {
+    const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kItems + k;
+    keys[k] = at < count ? uncertain[at] : kEmptyKey;
+  }
+  using Sort = FinishTaskSort<kItems>;
+  Sort(*reinterpret_cast<typename Sort::TempStorage*>(shared))
+      .SortBlockedToStriped(keys, 0, task_bits);
+  for (int k = 0; k < kItems; ++k) {
+    const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
+    if (at < count) out.uncertain[at] = keys[k];
+  }
+}
 
 /// The frame's results to host memory: small sets sorted in shared memory (keys are distinct,
-/// so the order is total and the block's output is the device-wide sort's), the counters last.
+/// so the order is total and the block's output is the device-wide sort's), each with the
+/// fewest keys per thread that hold it (a sort's passes cost in proportion), the counters last.
 __global__ void __launch_bounds__(kFinishThreads)
     finish_kernel(const FrameCounters* counters, PairSet set, const uint64_t* uncertain,
                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
@@ -255,39 +301,26 @@ __global__ void __launch_bounds__(kFinishThreads)
   extern __shared__ __align__(16) unsigned char shared[];
   const FrameCounters c = *counters;
   const unsigned long long limit = min(out.limit, kFinishLimit);
+  constexpr unsigned long long threads = kFinishThreads;
   if (c.pairs > 0 && c.pairs <= limit && c.pairs <= set.pair_capacity) {
-    uint64_t keys[kFinishItems];
-    uint8_t status[kFinishItems];
-    for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kFinishItems + k;
-      keys[k] = at < c.pairs ? set.keys[at] : kEmptyKey;  // the empty key sorts last
-      status[k] = at < c.pairs ? set.status[at] : 0;
-    }
-    FinishPairSort(*reinterpret_cast<typename FinishPairSort::TempStorage*>(shared))
-        .SortBlockedToStriped(keys, status, 0, key_bits);
-    for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at =
-          static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
-      if (at < c.pairs) {
-        out.keys[at] = keys[k];
-        out.status[at] = status[k];
-      }
-    }
-    __syncthreads();  // the shared memory is the next sort's
+    if (c.pairs <= threads)
+      sort_pairs<1>(set, c.pairs, key_bits, out, shared);
+    else if (c.pairs <= 2 * threads)
+      sort_pairs<2>(set, c.pairs, key_bits, out, shared);
+    else if (c.pairs <= 4 * threads)
+      sort_pairs<4>(set, c.pairs, key_bits, out, shared);
+    else
+      sort_pairs<kFinishItems>(set, c.pairs, key_bits, out, shared);
   }
   if (c.uncertain > 0 && c.uncertain <= limit && c.uncertain <= uncertain_capacity) {
-    uint64_t keys[kFinishItems];
-    for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kFinishItems + k;
-      keys[k] = at < c.uncertain ? uncertain[at] : kEmptyKey;
-    }
-    FinishTaskSort(*reinterpret_cast<typename FinishTaskSort::TempStorage*>(shared))
-        .SortBlockedToStriped(keys, 0, task_bits);
-    for (int k = 0; k < kFinishItems; ++k) {
-      const unsigned long long at =
-          static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
-      if (at < c.uncertain) out.uncertain[at] = keys[k];
-    }
+    if (c.uncertain <= threads)
+      sort_tasks<1>(uncertain, c.uncertain, task_bits, out, shared);
+    else if (c.uncertain <= 2 * threads)
+      sort_tasks<2>(uncertain, c.uncertain, task_bits, out, shared);
+    else if (c.uncertain <= 4 * threads)
+      sort_tasks<4>(uncertain, c.uncertain, task_bits, out, shared);
+    else
+      sort_tasks<kFinishItems>(uncertain, c.uncertain, task_bits, out, shared);
   }
   if (threadIdx.x == 0) *out.counters = c;
 }
