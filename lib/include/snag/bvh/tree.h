@@ -62,67 +62,11 @@ SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test
   }
 }
 
-/// walk_subtree's walk, testing the two children of a node together: the same leaves in the
-/// same order, but the next step depends on one pair of box loads where walk_subtree's
-/// depends on one load per node tested, and a subtree left for later is entered without a
-/// second test. On a GPU, where a walk is a chain of dependent loads, that halves the chain.
-/// Memory: a few registers. `pending` has bit d set while the right child of the node at depth
-/// d (below `root`) overlaps and waits for the left one's subtree; a complete tree has at most
-/// 32 levels. The deepest waiting node is reached from any node below it by shifting its
-/// 1-based index (the ancestor k levels up of 0-based i is ((i + 1) >> k) - 1).
-template <class Test, class AtLeaf>
-SNAG_HD_INLINE void walk_subtree_by_children(const TreeView& tree, int32_t root, Test&& test,
-                                             AtLeaf&& at_leaf) {
-  const int32_t first_leaf = tree.shape.leaf_count - 1;
-  if (!test(root)) return;
-  if (root >= first_leaf) {
-    at_leaf(root);
-    return;
-  }
-  uint32_t pending = 0;
-  int32_t node = root;  // an overlapping internal node whose children are tested next
-  int depth = 0;
-  while (true) {
-    const int32_t left = 2 * node + 1, right = left + 1;
-    const bool hit_left = test(left), hit_right = test(right);
-    int32_t next = -1;  // the internal node to expand next, if any
-    if (hit_left) {
-      if (hit_right) pending |= 1u << depth;
-      if (left >= first_leaf)
-        at_leaf(left);
-      else
-        next = left;
-    } else if (hit_right) {
-      if (right >= first_leaf)
-        at_leaf(right);
-      else
-        next = right;
-    }
-    if (next >= 0) {
-      node = next;
-      ++depth;
-      continue;
-    }
-    // The deepest waiting right child: a leaf is visited at once and the search goes on.
-    while (true) {
-      if (pending == 0) return;
-      const int waiting = floor_log2(pending);  // the parent's depth
-      pending &= ~(1u << waiting);
-      const int32_t parent = static_cast<int32_t>(
-          (static_cast<uint32_t>(node) + 1) >> (depth - waiting)) - 1;
-      node = 2 * parent + 2;
-      depth = waiting + 1;
-      if (node < first_leaf) break;
-      at_leaf(node);
-    }
-  }
-}
-
 /// Calls visit(leaf) with the node index of every leaf after `position` (in leaf order) whose
 /// box overlaps the leaf at `position`, so that each unordered pair of leaves is visited once,
 /// from the earlier one. For every ancestor reached from a left child, the right sibling's
-/// subtree holds exactly the later leaves under that ancestor; each is walked
-/// (walk_subtree_by_children). Nothing but boxes is read.
+/// subtree holds exactly the later leaves under that ancestor; each is walked (walk_subtree).
+/// Nothing but boxes is read.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t position,
                                                     Visit&& visit) {
@@ -130,7 +74,7 @@ SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t posit
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
-    walk_subtree_by_children(
+    walk_subtree(
         tree, node + 1, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
   }
 }
@@ -148,7 +92,7 @@ SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visi
 template <class Visit>
 SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box,
                                               Visit&& visit) {
-  walk_subtree_by_children(
+  walk_subtree(
       tree, 0, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
 }
 
