@@ -30,7 +30,7 @@ for step in "${steps[@]}"; do
       # quality, scan, narrow phase, expansion, the one-block finish, the growth and the
       # device-wide sorts of the large path).
       memcheck_filter='-CudaDetect.SharedDataFilesMatchTheCpu:CudaDetect.RandomSoupsWithFilterDecisionsMatchTheCpu'
-      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*:CudaScene.*'
+      racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*:CudaScene.ScenesMatchTheCpuAndBruteForce*'
       for tool in memcheck racecheck; do
         filter=$memcheck_filter; [ $tool = racecheck ] && filter=$racecheck_filter
         timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
