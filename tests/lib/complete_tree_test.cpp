@@ -190,6 +190,48 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   }
 }
 
+TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
+  // Random boxes searched under random roots: the same leaves in the same order, and the same
+  // nodes tested.
+  std::mt19937 rng(7);
+  for (int32_t n : {1, 2, 3, 5, 8, 9, 64, 100, 513, 2000}) {
+    for (double size : {0.05, 0.3, 1.0, 4.0}) {
+      Soup soup = random_soup(n, static_cast<uint32_t>(n * 13 + size * 5), size);
+      Tree tree;
+      tree.build(soup.view(), 1);
+      const TreeView view = tree.view();
+      std::uniform_int_distribution<int32_t> node_of(0, view.shape.node_count() - 1);
+      std::uniform_real_distribution<float> coordinate(-1.0f, 11.0f), extent(0.0f, 3.0f);
+      for (int query = 0; query < 40; ++query) {
+        geom::Box3f box;
+        for (int k = 0; k < 3; ++k) {
+          box.lo[k] = coordinate(rng);
+          box.hi[k] = box.lo[k] + extent(rng);
+        }
+        const int32_t root = query == 0 ? 0 : node_of(rng);
+        std::vector<int32_t> expected, visited;
+        int64_t expected_tests = 0, tests = 0;
+        walk_subtree(
+            view, root,
+            [&](int32_t i) {
+              ++expected_tests;
+              return geom::overlap(box, view.boxes[i]);
+            },
+            [&](int32_t leaf) { expected.push_back(leaf); });
+        walk_subtree_read_ahead(
+            view, root,
+            [&](const geom::Box3f& other) {
+              ++tests;
+              return geom::overlap(box, other);
+            },
+            [&](int32_t leaf) { visited.push_back(leaf); });
+        ASSERT_EQ(visited, expected) << "n=" << n << " size=" << size << " root=" << root;
+        ASSERT_EQ(tests, expected_tests) << "n=" << n << " size=" << size << " root=" << root;
+      }
+    }
+  }
+}
+
 TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
   // Coordinates past FLT_MAX (finite doubles) give leaf boxes of +-FLT_MAX or infinity, which
   // also "overlap" an empty box: lanes without a member must still never be visited.

@@ -34,6 +34,21 @@ SNAG_HD_INLINE void refit_internal(int32_t node, TreeView tree) {
   tree.boxes[node] = geom::merge(tree.boxes[2 * node + 1], tree.boxes[2 * node + 2]);
 }
 
+/// Where walk_subtree goes from node i: its left child `left` when i is `internal` and
+/// overlaps, else `skip`, the next subtree in depth-first order; `last` when there is none
+/// under the walk's root (at root_level).
+struct WalkStep {
+  int32_t left, skip;
+  bool internal, last;
+};
+
+SNAG_HD_INLINE WalkStep walk_step(int32_t i, int32_t first_leaf, int root_level) {
+  const uint32_t j = static_cast<uint32_t>(i) + 1;
+  const int climb = count_trailing_zeros(~j);
+  return {2 * i + 1, static_cast<int32_t>(j >> climb), i < first_leaf,
+          climb >= floor_log2(j) - root_level};
+}
+
 /// Walks the subtree under `root` depth-first without a stack: test(node) says whether a
 /// node's box overlaps what is searched for; at an overlapping leaf, at_leaf(leaf) is called.
 /// Memory: a few registers.
@@ -52,21 +67,44 @@ SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test
   int32_t i = root;
   while (true) {
     const bool hit = test(i);
-    const bool internal = i < first_leaf;
-    if (hit & !internal) at_leaf(i);
-    const bool descend = hit & internal;
-    const uint32_t j = static_cast<uint32_t>(i) + 1;
-    const int climb = count_trailing_zeros(~j);
-    if (!descend & (climb >= floor_log2(j) - root_level)) break;
-    i = descend ? 2 * i + 1 : static_cast<int32_t>(j >> climb);
+    const WalkStep step = walk_step(i, first_leaf, root_level);
+    if (hit & !step.internal) at_leaf(i);
+    const bool descend = hit & step.internal;
+    if (!descend & step.last) break;
+    i = descend ? step.left : step.skip;
+  }
+}
+
+/// walk_subtree with the boxes read one step ahead: overlaps(box) tests a node's box, and both
+/// possible successors' boxes are read before the current one is tested, so that the read
+/// leaves the step's chain of dependent instructions. On a GPU, where a walk is that chain and
+/// little else hides it, this took the 36K walk from 77 to 69 us. Same nodes, same order.
+template <class Overlaps, class AtLeaf>
+SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root,
+                                            Overlaps&& overlaps, AtLeaf&& at_leaf) {
+  const int32_t first_leaf = tree.shape.leaf_count - 1;
+  const int root_level = CompleteTree::level_of(root);
+  int32_t i = root;
+  geom::Box3f box = tree.boxes[root];
+  while (true) {
+    const WalkStep step = walk_step(i, first_leaf, root_level);
+    // A successor that does not exist reads node i again (in cache) rather than branching.
+    const geom::Box3f left_box = tree.boxes[step.internal ? step.left : i];
+    const geom::Box3f skip_box = tree.boxes[step.last ? i : step.skip];
+    const bool hit = overlaps(box);
+    if (hit & !step.internal) at_leaf(i);
+    const bool descend = hit & step.internal;
+    if (!descend & step.last) break;
+    i = descend ? step.left : step.skip;
+    box = descend ? left_box : skip_box;
   }
 }
 
 /// Calls visit(leaf) with the node index of every leaf after `position` (in leaf order) whose
 /// box overlaps the leaf at `position`, so that each unordered pair of leaves is visited once,
 /// from the earlier one. For every ancestor reached from a left child, the right sibling's
-/// subtree holds exactly the later leaves under that ancestor; each is walked (walk_subtree).
-/// Nothing but boxes is read.
+/// subtree holds exactly the later leaves under that ancestor; each is walked
+/// (walk_subtree_read_ahead). Nothing but boxes is read.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t position,
                                                     Visit&& visit) {
@@ -74,8 +112,9 @@ SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t posit
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
-    walk_subtree(
-        tree, node + 1, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
+    walk_subtree_read_ahead(
+        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); },
+        visit);
   }
 }
 
@@ -92,8 +131,8 @@ SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visi
 template <class Visit>
 SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box,
                                               Visit&& visit) {
-  walk_subtree(
-      tree, 0, [&](int32_t i) { return geom::overlap(box, tree.boxes[i]); }, visit);
+  walk_subtree_read_ahead(
+      tree, 0, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
 }
 
 /// for_each_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
