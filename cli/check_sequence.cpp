@@ -67,7 +67,7 @@ struct Meter {
   std::unique_ptr<measure::PenetrationMeter> meter;
   std::vector<int32_t> cloths;
   std::vector<measure::Clearance> clearances;  ///< per cloth: what earlier frames proved
-  bool fresh = true;  ///< made this frame, with its positions
+  bool fresh = true;                           ///< made this frame, with its positions
 };
 
 /// One object's part of the scene's (welded) triangles, its own vertex ids from 0.
@@ -377,9 +377,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             penetration.push_back(*kept);
             continue;
           }
-          const measure::PenetrationStats stats =
-              m.meter->measure(slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c],
-                               settings.threads);
+          const measure::PenetrationStats stats = m.meter->measure(
+              slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c], settings.threads);
           penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
                                  stats.max_depth, stats.mean_depth, stats.p95_depth});
         }

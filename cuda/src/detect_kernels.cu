@@ -163,8 +163,8 @@ __global__ void __launch_bounds__(kNarrowBlock)
 /// nothing.
 template <detect::FilterUse use>
 __global__ void __launch_bounds__(kBlock)
-    pair_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
-                     CandidateList listed, ResultBuffers out) {
+    pair_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base, CandidateList listed,
+                     ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
   const auto i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -243,11 +243,10 @@ template <int kItems>
 using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kItems>;
 
 /// Shared memory of finish_kernel: the largest sort's (more than the static 48 KB, so dynamic).
-constexpr size_t kFinishShared =
-    sizeof(typename FinishPairSort<kFinishItems>::TempStorage) >
-            sizeof(typename FinishTaskSort<kFinishItems>::TempStorage)
-        ? sizeof(typename FinishPairSort<kFinishItems>::TempStorage)
-        : sizeof(typename FinishTaskSort<kFinishItems>::TempStorage);
+constexpr size_t kFinishShared = sizeof(typename FinishPairSort<kFinishItems>::TempStorage) >
+                                         sizeof(typename FinishTaskSort<kFinishItems>::TempStorage)
+                                     ? sizeof(typename FinishPairSort<kFinishItems>::TempStorage)
+                                     : sizeof(typename FinishTaskSort<kFinishItems>::TempStorage);
 
 /// Sorts `count` (at most kFinishThreads * kItems) pairs of the set by key into `out`.
 template <int kItems>
@@ -351,8 +350,8 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
                        detect::FilterUse use, cudaStream_t stream) {
   const auto items = static_cast<int64_t>(listed.capacity);
   if (use == detect::FilterUse::certify)
-    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, walked,
-           walked_base, listed, results);
+    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, walked, walked_base,
+           listed, results);
   else
     launch(pair_test_kernel<detect::FilterUse::defer_all>, items, stream, inputs, walked,
            walked_base, listed, results);
@@ -370,7 +369,7 @@ void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
   self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs.degenerate,
-                                                                    listed, results.counters);
+                                                                   listed, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
   launch_pair_tests(inputs, tree, base, listed, results, use, stream);
 }

@@ -11,9 +11,10 @@
 namespace snag::cuda {
 
 inline constexpr int kBlock = 256;
-/// The narrow phase's blocks: 36K triangles are only ~270 traversal threads per SM of an H100,
-/// so blocks of 64 spread them evenly (blocks of 256 left a few SMs with two blocks, the rest
-/// with one, and the frame waited for the doubled ones).
+/// The walks' blocks: 36K triangles are only ~270 walks per SM of an H100, so blocks of 64
+/// spread them evenly. (With the walk that also tested its pairs, blocks of 256 left a few SMs
+/// with two blocks and the frame waited for them; the box-only walk is the same at 64, 128 and
+/// 256, cuda/NOTES.md.)
 inline constexpr int kNarrowBlock = 64;
 
 template <class... Params, class... Args>

@@ -495,16 +495,20 @@ void expect_scene_matches(int64_t capacity) {
     const detect::FrameResult c = cpu.check({frames[f], moved[f], {}, {}});
     SmallMesh frame_mesh{frames[f], laid.mesh.triangles};
     EXPECT_EQ(g.pairs, c.pairs) << "capacity " << capacity << " frame " << f;
-    EXPECT_EQ(g.pairs, expected_pairs({frame_mesh, laid.layout}, checks)) << "capacity " << capacity << " frame " << f;
+    EXPECT_EQ(g.pairs, expected_pairs({frame_mesh, laid.layout}, checks))
+        << "capacity " << capacity << " frame " << f;
     EXPECT_EQ(g.degenerate, c.degenerate) << "capacity " << capacity << " frame " << f;
     EXPECT_EQ(g.candidate_pairs, c.candidate_pairs) << "capacity " << capacity << " frame " << f;
     ASSERT_EQ(g.checks.size(), c.checks.size());
     for (size_t k = 0; k < g.checks.size(); ++k) {
-      EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs) << "capacity " << capacity << " frame " << f << " check " << k;
-      EXPECT_EQ(g.checks[k].reused, c.checks[k].reused) << "capacity " << capacity << " frame " << f << " check " << k;
+      EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs)
+          << "capacity " << capacity << " frame " << f << " check " << k;
+      EXPECT_EQ(g.checks[k].reused, c.checks[k].reused)
+          << "capacity " << capacity << " frame " << f << " check " << k;
     }
     for (size_t p = 0; p < g.parts.size(); ++p)
-      EXPECT_EQ(g.parts[p].tree_quality, c.parts[p].tree_quality) << "capacity " << capacity << " frame " << f;
+      EXPECT_EQ(g.parts[p].tree_quality, c.parts[p].tree_quality)
+          << "capacity " << capacity << " frame " << f;
   }
   EXPECT_EQ(gpu.build_count(), 3);
 }

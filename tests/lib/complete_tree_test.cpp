@@ -193,7 +193,8 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
 TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
   // Random boxes searched under random roots: the same leaves in the same order, and the same
   // nodes tested.
-  std::mt19937 rng(7);
+  const uint32_t seed = 7;
+  std::mt19937 rng(seed);
   for (int32_t n : {1, 2, 3, 5, 8, 9, 64, 100, 513, 2000}) {
     for (double size : {0.05, 0.3, 1.0, 4.0}) {
       Soup soup = random_soup(n, static_cast<uint32_t>(n * 13 + size * 5), size);
@@ -225,8 +226,11 @@ TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
               return geom::overlap(box, other);
             },
             [&](int32_t leaf) { visited.push_back(leaf); });
-        ASSERT_EQ(visited, expected) << "n=" << n << " size=" << size << " root=" << root;
-        ASSERT_EQ(tests, expected_tests) << "n=" << n << " size=" << size << " root=" << root;
+        const std::string where = "n=" + std::to_string(n) + " size=" + std::to_string(size) +
+                                  " query=" + std::to_string(query) +
+                                  " root=" + std::to_string(root) + " seed=" + std::to_string(seed);
+        ASSERT_EQ(visited, expected) << where;
+        ASSERT_EQ(tests, expected_tests) << where;
       }
     }
   }

@@ -394,8 +394,17 @@ TEST(Penetration, ClearanceSkipsOnlyPointsProvenOutside) {
   }
   // Most random points in the torus's box sit farther from the surface than they move.
   EXPECT_GT(skipped, 11 * 3000 / 2);
-  // Given a list of another length, the clearance starts over.
+  // Given to another meter, or with a list of another length, the clearance starts over.
+  const PenetrationMeter other = meter_for(s);
+  EXPECT_EQ(other.measure(points, clearance, 2).proven_outside, 0);
+  EXPECT_GT(other.measure(points, clearance, 2).proven_outside, 0);
   points.resize(100);
+  EXPECT_EQ(meter.measure(points, clearance, 2).proven_outside, 0);
+  // A non-finite obstacle position proves nothing about travel: no point is skipped again.
+  EXPECT_GT(meter.measure(points, clearance, 2).proven_outside, 0);
+  s.positions[0].x = std::numeric_limits<double>::quiet_NaN();
+  meter.update_positions(s.positions, 2);
+  EXPECT_TRUE(std::isnan(meter.travel()));
   EXPECT_EQ(meter.measure(points, clearance, 2).proven_outside, 0);
 }
 

@@ -319,6 +319,8 @@ Reading read_point(geom::Vec3d p, const Surface& s) {
   return {distance, geom::dot(p - best.point, normal) < 0.0 ? distance : 0.0};
 }
 
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
 int thread_count(int threads) {
   return threads > 0 ? threads : omp_get_max_threads();
 }
@@ -350,12 +352,19 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
   const auto n = static_cast<int32_t>(triangles_.size());
   if (built_) {
     double moved2 = 0.0;
+    bool finite = true;
     for (int32_t v = 0; v < vertex_count_; ++v) {
       const geom::Vec3d d = obstacle_positions[v] - positions_[v];
-      moved2 = std::max(moved2, geom::dot(d, d));
+      const double d2 = geom::dot(d, d);
+      finite &= std::isfinite(d2);
+      moved2 = std::max(moved2, d2);
     }
-    travel_ += std::sqrt(moved2);
+    // A movement that is not finite bounds nothing: the travel is NaN from then on.
+    travel_ = finite ? travel_ + std::sqrt(moved2) : std::numeric_limits<double>::quiet_NaN();
   }
+  extent_ = 0.0;
+  for (const geom::Vec3d& v : obstacle_positions)
+    extent_ = std::max({extent_, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
   positions_.assign(obstacle_positions.begin(), obstacle_positions.end());
   face_normal_.resize(triangles_.size());
   vertex_normal_.resize(positions_.size());
@@ -421,9 +430,10 @@ PenetrationStats PenetrationMeter::measure_points(std::span<const geom::Vec3d> p
   const auto count = static_cast<int64_t>(points.size());
   const geom::Vec3d* point = points.data();
   double* out = depth.data();
-  if (clearance && clearance->reach.size() != points.size()) {
+  if (clearance && (clearance->reach.size() != points.size() || clearance->meter != this)) {
     clearance->anchor.assign(points.begin(), points.end());
     clearance->reach.assign(points.size(), -std::numeric_limits<double>::infinity());
+    clearance->meter = this;
   }
   geom::Vec3d* anchor = clearance ? clearance->anchor.data() : nullptr;
   double* reach = clearance ? clearance->reach.data() : nullptr;
@@ -443,11 +453,16 @@ PenetrationStats PenetrationMeter::measure_points(std::span<const geom::Vec3d> p
     const Reading r = read_point(point[i], surface);
     out[i] = r.depth;
     if (reach) {
-      // Only an outside point at a positive, finite distance proves anything later; the
-      // margin covers the rounding of this distance and of the later movement sums.
+      // Only an outside point at a positive, finite distance proves anything later. The
+      // margin covers the rounding of this distance (relative to it and to the coordinates'
+      // magnitude) and of the later movement sums (to the travel's).
       anchor[i] = point[i];
-      reach[i] = r.depth == 0.0 && r.distance > 0.0 && std::isfinite(r.distance)
-                     ? r.distance * (1.0 - 1e-9) + travel
+      const double magnitude =
+          std::max({std::abs(point[i].x), std::abs(point[i].y), std::abs(point[i].z), extent_}) +
+          travel;
+      const double margin = 1e-9 * r.distance + 64 * kEpsilon * magnitude;
+      reach[i] = r.depth == 0.0 && r.distance > margin && std::isfinite(r.distance + magnitude)
+                     ? r.distance - margin + travel
                      : -std::numeric_limits<double>::infinity();
     }
   }

@@ -33,7 +33,7 @@ struct StageTimes {
   double refit = 0;     ///< boxes and planes from the current positions (0 when refit() found
                         ///< the tree already fit to them, refit ahead in the scan or built)
   double quality = 0;   ///< tree quality, back on the host (not updated when it was ready)
-  double traverse = 0;  ///< the traversal and the neighbour pass with the filtered narrow phase
+  double traverse = 0;  ///< the checks' walks and their pair tests (the filtered narrow phase)
   double classify = 0;  ///< hits expanded into distinct classified pairs, sorted, on the host
 };
 

@@ -80,8 +80,8 @@ SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test
 /// leaves the step's chain of dependent instructions. On a GPU, where a walk is that chain and
 /// little else hides it, this took the 36K walk from 77 to 69 us. Same nodes, same order.
 template <class Overlaps, class AtLeaf>
-SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root,
-                                            Overlaps&& overlaps, AtLeaf&& at_leaf) {
+SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root, Overlaps&& overlaps,
+                                            AtLeaf&& at_leaf) {
   const int32_t first_leaf = tree.shape.leaf_count - 1;
   const int root_level = CompleteTree::level_of(root);
   int32_t i = root;
@@ -113,17 +113,15 @@ SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t posit
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
     walk_subtree_read_ahead(
-        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); },
-        visit);
+        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
   }
 }
 
 /// for_each_later_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
-  for_each_later_overlapping_leaf(tree, position, [&](int32_t leaf) {
-    visit(tree.triangle_at[tree.shape.position_of(leaf)]);
-  });
+  for_each_later_overlapping_leaf(
+      tree, position, [&](int32_t leaf) { visit(tree.triangle_at[tree.shape.position_of(leaf)]); });
 }
 
 /// Calls visit(leaf) with the node index of every leaf of `tree` whose box overlaps `box`: a
@@ -133,14 +131,6 @@ SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& 
                                               Visit&& visit) {
   walk_subtree_read_ahead(
       tree, 0, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
-}
-
-/// for_each_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
-template <class Visit>
-SNAG_HD_INLINE void for_each_overlap(TreeView tree, const geom::Box3f& box, Visit&& visit) {
-  for_each_overlapping_leaf(tree, box, [&](int32_t leaf) {
-    visit(tree.triangle_at[tree.shape.position_of(leaf)]);
-  });
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the

@@ -26,7 +26,9 @@
 // remembers, per point, where it was last measured outside and how far from the surface; while
 // its movement since then plus the obstacle's travel since then stays below that distance it is
 // still outside (its winding number cannot change without the surface passing through it) and
-// is not measured again. The result is the same as measuring every point.
+// is not measured again. On a surface that does not intersect itself the result is the same as
+// measuring every point. On one that does, the pseudonormal's side is ambiguous where the
+// surface overlaps itself, and there a point's answer can depend on the frames measured before.
 #pragma once
 
 #include <cstdint>
@@ -75,11 +77,12 @@ struct PenetrationStats {
 /// What earlier measure() calls of one meter proved about a list of points (a cloth's
 /// vertices, frame after frame): per point, where it was last found outside and the obstacle
 /// travel (PenetrationMeter::travel()) it could then take before it might reach the surface.
-/// A Clearance belongs to one meter and one list length; given to another length it starts
-/// over. Not shared between threads.
+/// A Clearance belongs to one meter and one list length; given to another meter or another
+/// length it starts over. Not shared between threads.
 struct Clearance {
   std::vector<geom::Vec3d> anchor;  ///< where each point was last measured
   std::vector<double> reach;        ///< its distance then plus the travel then; -inf: re-measure
+  const void* meter = nullptr;      ///< the meter whose travel `reach` counts from
 };
 
 /// Inside/outside and depth of points with respect to a closed obstacle surface. The meter is
@@ -110,14 +113,16 @@ class PenetrationMeter {
                            std::vector<double>* depths = nullptr) const;
 
   /// measure(), skipping the points `clearance` proves are still outside, and updating it
-  /// with what this call finds. The result is measure()'s (up to a margin of 1e-9 of a
-  /// point's distance kept against rounding).
+  /// with what this call finds. The result is measure()'s on a surface that does not intersect
+  /// itself (see the file comment); a point is skipped only with a margin against rounding:
+  /// 1e-9 of its distance plus a few ulps of the coordinates' and the travel's magnitudes.
   PenetrationStats measure(std::span<const geom::Vec3d> points, Clearance& clearance,
                            int threads = 0, std::vector<double>* depths = nullptr) const;
 
   /// The sum over update_positions() calls of the largest distance any obstacle vertex moved
   /// in that call: an upper bound on how far any point of the surface has moved since an
-  /// earlier call (0 after the first).
+  /// earlier call (0 after the first; NaN from a call with a non-finite position on, which
+  /// proves nothing, so no point is skipped).
   double travel() const { return travel_; }
 
   /// The signed volume the surface encloses at the last update_positions() (0 before): positive
@@ -141,6 +146,7 @@ class PenetrationMeter {
   bvh::Tree tree_;
   double enclosed_volume_ = 0;
   double travel_ = 0;
+  double extent_ = 0;  ///< the largest coordinate magnitude of the positions, for the margin
   bool built_ = false;
 
   PenetrationStats measure_points(std::span<const geom::Vec3d> points, Clearance* clearance,
