@@ -246,6 +246,7 @@ struct SequenceRow {
   double both = 0;   ///< seconds: the frame loop of `snag check`, reports written
   int readers = 0;   ///< reader threads `snag check` used
   int64_t pairs = 0;
+  LoopTimes loop;  ///< where `snag check`'s loop spent `both`
 };
 
 /// Seconds to read every frame with `readers` threads, as `snag check` reads them.
@@ -290,7 +291,7 @@ double time_checking(const std::vector<seq::Frame>& frames, const std::string& b
 /// Seconds of `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
 double time_check_command(const std::vector<seq::Frame>& frames, const std::string& backend,
                           int threads, int device, const fs::path& out, int& readers,
-                          int64_t& pairs) {
+                          int64_t& pairs, LoopTimes& loop) {
   const std::unique_ptr<detect::Checker> checker = make_sequence_checker(backend, threads, device);
   {  // warm-up, as for checking alone: the device and its buffers
     const mesh::Mesh first = io::read_mesh(frames.front().path);
@@ -300,6 +301,7 @@ double time_check_command(const std::vector<seq::Frame>& frames, const std::stri
   SequenceSettings settings;
   settings.threads = threads;
   settings.gpu = checker->backend_name() == "cuda";
+  settings.times = &loop;
   readers = readers_for(settings.threads, settings.gpu);
   const auto started = Clock::now();
   report::ReportStream stream(out, SNAG_VERSION, {});
@@ -326,7 +328,7 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
     row.check = time_checking(frames, backend, threads, device, row.pairs);
     int64_t pipeline_pairs = 0;
     row.both = time_check_command(frames, backend, threads, device, scratch / backend, row.readers,
-                                  pipeline_pairs);
+                                  pipeline_pairs, row.loop);
     if (pipeline_pairs != row.pairs)
       throw InternalError("bench io: snag check found " + std::to_string(pipeline_pairs) +
                           " pairs, checking from memory " + std::to_string(row.pairs));
@@ -354,6 +356,16 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
                 r.readers, r.read, r.check, r.both, bytes / r.both / 1e6, r.both / r.read,
                 r.both / larger, static_cast<long long>(r.pairs));
   }
+  std::printf(
+      "\nWhere snag check's loop spent its time (seconds on the loop's thread): waiting = for\n"
+      "the readers; preparing = topology, weld, what moved; checking = Checker::check; "
+      "recording =\nthe frame's record; handing = to the report stream, the frame before "
+      "released\n");
+  std::printf("%-8s %9s %10s %9s %10s %9s %9s\n", "backend", "waiting", "preparing", "checking",
+              "recording", "handing", "loop");
+  for (const SequenceRow& r : rows)
+    std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f\n", r.backend.c_str(), r.loop.waiting,
+                r.loop.preparing, r.loop.checking, r.loop.recording, r.loop.handing, r.both);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -183,13 +183,23 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   // On a GPU the frame after the current one is taken first, so that its positions cross the
   // bus while the current one is checked. Its error, if reading it failed, waits for its turn.
   // The previous frame is kept to tell which objects moved.
+  LoopTimes times;
+  auto mark = Clock::now();
+  // Adds the time since the last mark to `slot`.
+  const auto lap = [&](double& slot) {
+    const auto now = Clock::now();
+    slot += std::chrono::duration<double>(now - mark).count();
+    mark = now;
+  };
   Upcoming current = take_next(prefetcher);
+  lap(times.waiting);
   std::optional<ScenePrefetcher::Prefetched> previous;
   std::vector<report::Penetration> last_penetration;
   while (current.error || current.frame) {
     if (current.error) std::rethrow_exception(current.error);
     Upcoming following;
     if (settings.gpu) following = take_next(prefetcher);
+    lap(times.waiting);
 
     const size_t i = current.frame->index;
     const seq::Frame& frame = scene.frames[i];
@@ -316,8 +326,10 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       next_positions = following.frame->item.mesh.positions;
       next_moved = moved_between(scene_frame, following.frame->item);
     }
+    lap(times.preparing);
     const detect::FrameResult result =
         checker.check({mesh.positions, moved, next_positions, next_moved});
+    lap(times.checking);
 
     report::FrameRecord record;
     if (!scene_report) {
@@ -393,11 +405,16 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
     }
     record.topology_changed = topology_changed;
     record.read_seconds = read_seconds;
+    lap(times.recording);
     on_frame(std::move(record));
+    lap(times.handing);
 
     previous = std::move(current.frame);
+    lap(times.handing);
     current = settings.gpu ? std::move(following) : take_next(prefetcher);
+    lap(times.waiting);
   }
+  if (settings.times) *settings.times = times;
   inputs.ids = any_assimp ? "assimp" : "file";
 }
 

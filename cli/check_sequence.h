@@ -15,10 +15,21 @@
 
 namespace snag::cli {
 
+/// Where the frame loop's time went, in seconds summed over frames (on the loop's thread).
+struct LoopTimes {
+  double waiting = 0;    ///< for the readers: the frames were not read yet
+  double preparing = 0;  ///< topology and weld decisions, what moved (reading's share)
+  double checking = 0;   ///< Checker::check, exact decisions included
+  double recording = 0;  ///< the frame's record: ids, groups, penetration
+  double handing = 0;    ///< on_frame (the report stream takes the record), the frame before
+                         ///< released
+};
+
 struct SequenceSettings {
   std::optional<double> weld;  ///< --weld: vertices closer than this count as one for adjacency
   int threads = 1;             ///< the checker's worker threads (readers come on top)
   bool gpu = false;            ///< the checker runs on a GPU (see readers_for)
+  LoopTimes* times = nullptr;  ///< when given, filled with where the loop's time went
 };
 
 /// Reader threads for a run with `threads` workers. On the CPU the checker's threads do the
