@@ -13,11 +13,12 @@
 namespace snag::test {
 namespace {
 
-/// The whitespace-separated words of the line of `text` that starts with `prefix`.
-std::vector<std::string> row(const std::string& text, const std::string& prefix) {
+/// The whitespace-separated words of the `nth` line (from 0) of `text` that starts with
+/// `prefix`.
+std::vector<std::string> row(const std::string& text, const std::string& prefix, int nth = 0) {
   std::istringstream lines(text);
   for (std::string line; std::getline(lines, line);) {
-    if (line.rfind(prefix, 0) != 0) continue;
+    if (line.rfind(prefix, 0) != 0 || nth-- > 0) continue;
     std::istringstream in(line.substr(prefix.size()));
     std::vector<std::string> words;
     for (std::string w; in >> w;) words.push_back(w);
@@ -51,8 +52,19 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   }
   const std::vector<std::string> cpu = row(r.out, "cpu ");
   ASSERT_EQ(cpu.size(), 8u);
-  EXPECT_EQ(cpu[0], "1");  // readers: a quarter of 2 threads, at least one
+  EXPECT_EQ(cpu[0], "1");           // readers: a quarter of 2 threads, at least one
   EXPECT_GT(std::stod(cpu[3]), 0);  // snag check, seconds
+  // Where the loop's time went: five shares, none negative, adding up to no more than the loop.
+  const std::vector<std::string> loop = row(r.out, "cpu ", 1);
+  ASSERT_EQ(loop.size(), 6u);
+  double shares = 0;
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_GE(std::stod(loop[i]), 0) << i;
+    shares += std::stod(loop[i]);
+  }
+  EXPECT_GT(std::stod(loop[2]), 0);               // checking
+  EXPECT_EQ(loop[5], cpu[3]);                     // the loop is snag check's time
+  EXPECT_LE(shares, std::stod(loop[5]) + 0.005);  // three decimals each, rounded
   for (const char* frames : {"       2 ", "       8 "})
     EXPECT_EQ(row(r.out, frames).size(), 3u) << frames;
 }
