@@ -292,7 +292,8 @@ double time_checking(const std::vector<seq::Frame>& frames, const std::string& b
 double time_check_command(const std::vector<seq::Frame>& frames, const std::string& backend,
                           int threads, int device, const fs::path& out, int& readers,
                           int64_t& pairs, LoopTimes& loop) {
-  const std::unique_ptr<detect::Checker> checker = make_sequence_checker(backend, threads, device);
+  const std::unique_ptr<detect::Checker> checker =
+      make_sequence_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   {  // warm-up, as for checking alone: the device and its buffers
     const mesh::Mesh first = io::read_mesh(frames.front().path);
     checker->set_triangles(first.triangles, static_cast<int32_t>(first.positions.size()));
@@ -344,10 +345,11 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
               name.c_str(), frames.size(), bytes / 1e6, threads);
   std::printf(
       "read = %d reader threads, nothing checked; check = every frame from memory; snag "
-      "check = its frame\nloop (reading ahead on its reader threads, checking, writing "
-      "the reports); target: snag check\nwithin 10%% of the larger of read and check on "
-      "the CPU, of read on the GPU\n",
-      threads);
+      "check = its frame\nloop (reading ahead on its reader threads, checking, writing the "
+      "reports; %d threads in all on the\nCPU from 8 threads, readers on top below and on the "
+      "GPU); target: snag check within 10%% of the\nlarger of read and check on the CPU, of "
+      "read on the GPU\n",
+      threads, threads);
   std::printf("%-8s %8s %9s %9s %11s %8s %10s %10s %8s\n", "backend", "readers", "read", "check",
               "snag check", "MB/s", "/ read", "/ larger", "pairs");
   for (const SequenceRow& r : rows) {

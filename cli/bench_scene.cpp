@@ -264,7 +264,8 @@ std::unique_ptr<detect::Checker> make_scene_checker(const std::string& backend, 
 /// made and dropped): milliseconds between consecutive frames' records, and each frame's pairs.
 std::vector<double> time_frame_loop(const scene::ResolvedScene& scene, const std::string& backend,
                                     int threads, int device, std::vector<int64_t>& pairs) {
-  const std::unique_ptr<detect::Checker> checker = make_scene_checker(backend, threads, device);
+  const std::unique_ptr<detect::Checker> checker =
+      make_scene_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   SequenceSettings settings;
   settings.threads = threads;
   settings.gpu = checker->backend_name() == "cuda";

@@ -252,7 +252,10 @@ int run_check(const CheckOptions& o) {
   // once rather than after an hour of checking.
   if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
 
-  auto backend = make_backend(o.backend, o.threads, o.device);
+  // The run's threads are the checker's and its readers' (checker_threads_for).
+  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const bool on_gpu = o.backend == "cuda" || (o.backend == "auto" && cuda_devices() > 0);
+  auto backend = make_backend(o.backend, checker_threads_for(threads, on_gpu), o.device);
   const std::string backend_name(backend->name());
   detect::CheckSettings settings;
   settings.rebuild = rebuild_policy(o.rebuild);
@@ -264,7 +267,7 @@ int run_check(const CheckOptions& o) {
   report::Settings report_settings;
   report_settings.backend = backend_name;
   report_settings.backend_requested = o.backend;
-  report_settings.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  report_settings.threads = threads;
   report_settings.exact = std::string(detect::to_string(*exact));
   report_settings.exact_predicates = *exact == detect::ExactMode::off ? "rounded" : "cgal";
   report_settings.weld = o.weld;
@@ -287,7 +290,7 @@ int run_check(const CheckOptions& o) {
   Progress progress(static_cast<int64_t>(resolved.frames.size()), o.quiet);
   SequenceSettings sequence;
   sequence.weld = o.weld;
-  sequence.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  sequence.threads = threads;
   sequence.gpu = backend_name == "cuda";
   check_scene(
       resolved, *checker, sequence, scene_run, inputs,

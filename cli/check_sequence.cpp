@@ -134,6 +134,11 @@ int readers_for(int threads, bool gpu) {
   return gpu ? std::max(threads - 1, 1) : std::clamp(threads / 4, 1, 4);
 }
 
+int checker_threads_for(int threads, bool gpu) {
+  threads = std::max(threads, 1);
+  return gpu || threads < 8 ? threads : threads - readers_for(threads, gpu);
+}
+
 void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker,
                     const SequenceSettings& settings, report::Inputs& inputs,
                     const std::function<void(report::FrameRecord&&)>& on_frame,
@@ -168,6 +173,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   // is checked; at most readers + 2 frames are ahead whatever the sequence length.
   const scene::SceneReader reader(scene);
   const int readers = readers_for(settings.threads, settings.gpu);
+  const int workers = checker_threads_for(settings.threads, settings.gpu);
   std::vector<std::vector<io::FrameReader>> per_reader;
   for (int r = 0; r < readers; ++r) per_reader.push_back(reader.make_readers());
   ScenePrefetcher prefetcher(scene.frames, readers, readers + 2, [&](const seq::Frame& f, int r) {
@@ -302,12 +308,12 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
           const std::span<const geom::Vec3d> positions =
               slice(mesh.positions, layout.vertex_begin, obstacle);
           auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
-          meter->update_positions(positions, settings.threads);
+          meter->update_positions(positions, workers);
           if (meter->enclosed_volume() < 0) {
             std::vector<geom::Tri> flipped = local;
             for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
             meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
-            meter->update_positions(positions, settings.threads);
+            meter->update_positions(positions, workers);
           }
           meters.push_back({obstacle, std::move(meter), {}, {}, true});
           at = meters.end() - 1;
@@ -378,7 +384,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         const bool obstacle_moved = result.parts[m.obstacle].moved;
         if (obstacle_moved && !m.fresh)  // a fresh meter has this frame's positions
           m.meter->update_positions(slice(mesh.positions, layout.vertex_begin, m.obstacle),
-                                    settings.threads);
+                                    workers);
         for (size_t c = 0; c < m.cloths.size(); ++c) {
           const int32_t cloth = m.cloths[c];
           const auto kept = std::find_if(last_penetration.begin(), last_penetration.end(),
@@ -390,7 +396,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             continue;
           }
           const measure::PenetrationStats stats = m.meter->measure(
-              slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c], settings.threads);
+              slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c], workers);
           penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
                                  stats.max_depth, stats.mean_depth, stats.p95_depth});
         }

@@ -27,7 +27,8 @@ struct LoopTimes {
 
 struct SequenceSettings {
   std::optional<double> weld;  ///< --weld: vertices closer than this count as one for adjacency
-  int threads = 1;             ///< the checker's worker threads (readers come on top)
+  int threads = 1;             ///< the run's threads: the checker's (checker_threads_for, with
+                               ///< which its backend was made) and the readers (readers_for)
   bool gpu = false;            ///< the checker runs on a GPU (see readers_for)
   LoopTimes* times = nullptr;  ///< when given, filled with where the loop's time went
 };
@@ -37,6 +38,16 @@ struct SequenceSettings {
 /// GPU the host mostly waits, reading is the work, and every thread but the checker's reads.
 /// Readers wait whenever the frames ahead fill their ring (readers + 2 frames).
 int readers_for(int threads, bool gpu);
+
+/// The checker's worker threads in a run of `threads`. On the CPU with 8 threads or more, the
+/// readers' threads are taken out, so that the run stays within `threads`: OpenMP's workers
+/// spin between parallel regions, and readers that took their cores stalled the regions and
+/// were starved in turn (16 cores, 200 frames of 36K triangles: with the readers on top the
+/// loop waited 0.10-0.19 s for frames and took 1.84-1.98 times checking alone; with 12 workers
+/// and 4 readers, 0.01-0.02 s and 1.17-1.59 times). Below 8 threads, where a reader's core
+/// would be an eighth to a half of the check's, and on a GPU, where the host mostly waits, the
+/// readers come on top and the checker has all `threads`.
+int checker_threads_for(int threads, bool gpu);
 
 /// Reads `frames` ahead and checks them in order with `checker`:
 ///  - the topology comes from the first frame; later frames must have its vertex count, and a
