@@ -223,45 +223,52 @@ std::string pairs_array(const FrameRecord& f, int level, std::span<const std::st
   const std::vector<Pair>& pairs = f.pairs;
   const std::string object_margin = indent(level + 1), member_margin = indent(level + 2);
   const bool scene = !names.empty();
+  // The text between a pair's values, each one piece: a pair is then 5 (single mesh) or 9
+  // (scene) appends and 4 numbers, not a dozen small appends.
+  const std::string member_break = ",\n" + member_margin;
+  const std::string open_first = "\n" + object_margin + "{\n" + member_margin + "\"a\": ";
+  const std::string open_next = "," + open_first;
+  const std::string before_b = member_break + "\"b\": ";
+  const std::string crossing_then_poly =
+      member_break + "\"kind\": \"crossing\"" + member_break + "\"poly_a\": ";
+  const std::string touching_then_poly =
+      member_break + "\"kind\": \"touching\"" + member_break + "\"poly_a\": ";
+  const std::string before_poly_b = member_break + "\"poly_b\": ";
+  const std::string before_object_a = member_break + "\"object_a\": ";
+  const std::string before_object_b = member_break + "\"object_b\": ";
+  const std::string close = "\n" + object_margin + "}";
   std::string out = "[";
   out.reserve(pairs.size() * ((scene ? 8 : 6) * member_margin.size() + (scene ? 160 : 96)));
   char number[16];
-  const auto add_member = [&](const char* key, int32_t value, bool last) {
-    out += member_margin;
-    out += key;
+  const auto add_number = [&](int32_t value) {
     const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
     out.append(number, end);
-    out += last ? "\n" : ",\n";
   };
-  const auto add_name = [&](const char* key, int32_t object, const Pair& p, bool last) {
+  const auto name_of = [&](int32_t object, const Pair& p) -> const std::string& {
     if (object < 0 || static_cast<size_t>(object) >= names.size())
       throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
                           std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
                           std::to_string(object) + "; the scene has " +
                           std::to_string(names.size()));
-    out += member_margin;
-    out += key;
-    out += names[object];
-    out += last ? "\n" : ",\n";
+    return names[object];
   };
   for (size_t i = 0; i < pairs.size(); ++i) {
     const Pair& p = pairs[i];
-    out += i == 0 ? "\n" : ",\n";
-    out += object_margin;
-    out += "{\n";
-    add_member("\"a\": ", p.a, false);
-    add_member("\"b\": ", p.b, false);
-    out += member_margin;
-    out += p.kind == detect::PairKind::crossing ? "\"kind\": \"crossing\",\n"
-                                                : "\"kind\": \"touching\",\n";
-    add_member("\"poly_a\": ", p.poly_a, false);
-    add_member("\"poly_b\": ", p.poly_b, !scene);
+    out += i == 0 ? open_first : open_next;
+    add_number(p.a);
+    out += before_b;
+    add_number(p.b);
+    out += p.kind == detect::PairKind::crossing ? crossing_then_poly : touching_then_poly;
+    add_number(p.poly_a);
+    out += before_poly_b;
+    add_number(p.poly_b);
     if (scene) {
-      add_name("\"object_a\": ", p.object_a, p, false);
-      add_name("\"object_b\": ", p.object_b, p, true);
+      out += before_object_a;
+      out += name_of(p.object_a, p);
+      out += before_object_b;
+      out += name_of(p.object_b, p);
     }
-    out += object_margin;
-    out += '}';
+    out += close;
   }
   if (!pairs.empty()) {
     out += '\n';
