@@ -61,13 +61,18 @@ std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
   return moved;
 }
 
+/// A cloth measured against a meter, with what earlier frames proved about its vertices.
+struct MeasuredCloth {
+  int32_t object = 0;
+  measure::Clearance clearance;
+};
+
 /// A closed obstacle's meter, and the cloths it is measured against.
 struct Meter {
   int32_t obstacle = 0;
   std::unique_ptr<measure::PenetrationMeter> meter;
-  std::vector<int32_t> cloths;
-  std::vector<measure::Clearance> clearances;  ///< per cloth: what earlier frames proved
-  bool fresh = true;                           ///< made this frame, with its positions
+  std::vector<MeasuredCloth> cloths;
+  bool fresh = true;  ///< made this frame, with its positions
 };
 
 /// One object's part of the scene's (welded) triangles, its own vertex ids from 0.
@@ -315,11 +320,10 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
             meter->update_positions(positions, workers);
           }
-          meters.push_back({obstacle, std::move(meter), {}, {}, true});
+          meters.push_back({obstacle, std::move(meter), {}, true});
           at = meters.end() - 1;
         }
-        at->cloths.push_back(cloth);
-        at->clearances.emplace_back();
+        at->cloths.push_back({cloth, {}});
       }
     }
     const double read_seconds = current.frame->read_seconds + seconds_since(read_started);
@@ -385,8 +389,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         if (obstacle_moved && !m.fresh)  // a fresh meter has this frame's positions
           m.meter->update_positions(slice(mesh.positions, layout.vertex_begin, m.obstacle),
                                     workers);
-        for (size_t c = 0; c < m.cloths.size(); ++c) {
-          const int32_t cloth = m.cloths[c];
+        for (MeasuredCloth& measured : m.cloths) {
+          const int32_t cloth = measured.object;
           const auto kept = std::find_if(last_penetration.begin(), last_penetration.end(),
                                          [&](const report::Penetration& p) {
                                            return p.cloth == cloth && p.obstacle == m.obstacle;
@@ -396,7 +400,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
             continue;
           }
           const measure::PenetrationStats stats = m.meter->measure(
-              slice(mesh.positions, layout.vertex_begin, cloth), m.clearances[c], workers);
+              slice(mesh.positions, layout.vertex_begin, cloth), measured.clearance, workers);
           penetration.push_back({cloth, m.obstacle, stats.points, stats.inside, stats.ratio,
                                  stats.max_depth, stats.mean_depth, stats.p95_depth});
         }

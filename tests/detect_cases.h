@@ -170,15 +170,14 @@ inline SmallMesh lattice_soup(int32_t triangles, int32_t vertices, int range, ui
   return mesh;
 }
 
-/// A folded grid: a w x h sheet whose rows bend back through the sheet, in integer coordinates.
-inline SmallMesh folded_grid(int w, int h) {
+/// A grid of w x h cells, vertex (i, j) at `at(i, j)`, each cell split along the diagonal
+/// from (i, j) to (i + 1, j + 1): an interior vertex has 6 triangles, an edge along i or j
+/// has 2.
+template <class At>
+SmallMesh grid_mesh(int w, int h, At at) {
   SmallMesh mesh;
   for (int j = 0; j <= h; ++j)
-    for (int i = 0; i <= w; ++i) {
-      const int fold = (i * 3) % (2 * w);  // zig-zag in x: the sheet passes through itself
-      mesh.positions.push_back(
-          {double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)});
-    }
+    for (int i = 0; i <= w; ++i) mesh.positions.push_back(at(i, j));
   auto id = [&](int i, int j) { return j * (w + 1) + i; };
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
@@ -186,6 +185,14 @@ inline SmallMesh folded_grid(int w, int h) {
       mesh.triangles.push_back({{id(i, j), id(i + 1, j + 1), id(i, j + 1)}});
     }
   return mesh;
+}
+
+/// A folded grid: a w x h sheet whose rows bend back through the sheet, in integer coordinates.
+inline SmallMesh folded_grid(int w, int h) {
+  return grid_mesh(w, h, [w](int i, int j) {
+    const int fold = (i * 3) % (2 * w);  // zig-zag in x: the sheet passes through itself
+    return geom::Vec3d{double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)};
+  });
 }
 
 }  // namespace snag::test

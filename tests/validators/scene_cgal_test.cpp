@@ -28,27 +28,11 @@ using Pairs = std::vector<std::pair<int32_t, int32_t>>;
 using detect::FacePair;
 using detect::PairKind;
 using geom::Vec3d;
+using test::grid_mesh;
 using test::Laid;
 using test::SmallMesh;
 
 // ---- Generators ------------------------------------------------------------------------------
-
-/// A grid of w x h cells, vertex (i, j) at `at(i, j)`, each cell split along the diagonal
-/// from (i, j) to (i + 1, j + 1): an interior vertex has 6 triangles, an edge along i or j
-/// has 2.
-template <class At>
-SmallMesh cloth_grid(int w, int h, At at) {
-  SmallMesh mesh;
-  for (int j = 0; j <= h; ++j)
-    for (int i = 0; i <= w; ++i) mesh.positions.push_back(at(i, j));
-  auto id = [&](int i, int j) { return j * (w + 1) + i; };
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      mesh.triangles.push_back({{id(i, j), id(i + 1, j), id(i + 1, j + 1)}});
-      mesh.triangles.push_back({{id(i, j), id(i + 1, j + 1), id(i, j + 1)}});
-    }
-  return mesh;
-}
 
 /// A UV sphere: the poles (vertices 0 and 1) and stacks - 1 rings of `slices` vertices.
 SmallMesh uv_sphere(Vec3d center, double radius, int slices, int stacks) {
@@ -125,7 +109,7 @@ std::vector<double> grid_values(double from, double to, int n, std::vector<doubl
 /// A folded cloth (folded_grid's zig-zag with non-integer spacing): its rows pass through the
 /// sheet, so it intersects itself.
 SmallMesh folded_cloth(int w, int h, Vec3d origin) {
-  return cloth_grid(w, h, [&](int i, int j) {
+  return grid_mesh(w, h, [&](int i, int j) {
     const int fold = (i * 3) % (2 * w);
     return origin + Vec3d{0.1234 * (fold < w ? fold : 2 * w - fold), 0.2101 * j,
                           0.0731 * ((i * i) % 7) + 0.013 * std::sin(j)};
@@ -134,7 +118,7 @@ SmallMesh folded_cloth(int w, int h, Vec3d origin) {
 
 /// A wavy cloth of n x n cells over [-half, half]^2 around `center`, domed upward by `dome`.
 SmallMesh wavy_cloth(int n, double half, Vec3d center, double dome, double wave) {
-  return cloth_grid(n, n, [&](int i, int j) {
+  return grid_mesh(n, n, [&](int i, int j) {
     const double x = -half + 2 * half * i / n, y = -half + 2 * half * j / n;
     return center + Vec3d{x, y,
                           dome * std::exp(-(x * x + y * y)) +
@@ -231,7 +215,7 @@ TEST(SceneCgal, ReferenceIsEveryPairTestedOnGeneratedScenes) {
   const SmallMesh body = box(lo, hi, 3);
   const auto xs = grid_values(-0.9, 1.4, 16, {lo.x, hi.x});
   const auto ys = grid_values(-0.3, 1.5, 12, {lo.y, hi.y});
-  const SmallMesh pleated = cloth_grid(16, 12, [&](int i, int j) {
+  const SmallMesh pleated = grid_mesh(16, 12, [&](int i, int j) {
     return Vec3d{xs[i], ys[j], j % 2 ? hi.z + 0.05 + 0.02 * std::sin(i) : hi.z};
   });
   const std::vector<std::pair<SmallMesh, SmallMesh>> scenes = {
@@ -317,7 +301,7 @@ TEST(SceneCgal, ClothTouchingSphereExactlyIsTouching) {
   // A flat cloth in the pole's tangent plane z = pole.z, its column i = 4 at x = c.x exactly:
   // the pole on a cloth vertex, on a cloth edge (between rows), inside a cloth face.
   auto flat = [&](double dx, double dy, double z) {
-    return cloth_grid(8, 8, [&](int i, int j) {
+    return grid_mesh(8, 8, [&](int i, int j) {
       return Vec3d{c.x + (i - 4) * 0.113 + dx, c.y + (j - 4) * 0.097 + dy, z};
     });
   };
@@ -351,7 +335,7 @@ TEST(SceneCgal, ClothTouchingSphereExactlyIsTouching) {
   Vec3d e1 = geom::cross(n, {0, 0, 1});
   e1 = (1 / std::sqrt(geom::dot(e1, e1))) * e1;
   const Vec3d e2 = geom::cross(n, e1);
-  const SmallMesh cup = cloth_grid(10, 10, [&](int i, int j) {
+  const SmallMesh cup = grid_mesh(10, 10, [&](int i, int j) {
     const double u = (i - 5) * 0.09, w = (j - 5) * 0.11;
     return p + u * e1 + w * e2 + (0.8 * (u * u + w * w)) * n;
   });
@@ -373,12 +357,12 @@ TEST(SceneCgal, ClothOverBox) {
   // Pleats: even rows lie exactly on the top face's plane (their vertices on the face, on its
   // edges x = lo.x, hi.x and its corners; their edges along it), odd rows are raised.
   auto pleated = [&](double base) {
-    return cloth_grid(16, 12, [&](int i, int j) {
+    return grid_mesh(16, 12, [&](int i, int j) {
       return Vec3d{xs[i], ys[j], j % 2 ? base + 0.05 + 0.02 * std::sin(i) : base};
     });
   };
   auto draped = [&](double base, double sag) {
-    return cloth_grid(16, 12, [&](int i, int j) {
+    return grid_mesh(16, 12, [&](int i, int j) {
       const double x = xs[i] - 0.25, y = ys[j] - 0.6;
       return Vec3d{xs[i], ys[j], base - sag * std::exp(-4 * (x * x + y * y))};
     });
@@ -386,16 +370,14 @@ TEST(SceneCgal, ClothOverBox) {
   // Hanging against the side face x = lo.x: even columns in its plane, odd ones away from it.
   const auto side_ys = grid_values(-0.2, 1.4, 10, {lo.y, hi.y});
   const auto side_zs = grid_values(-0.9, 0.7, 10, {lo.z, hi.z});
-  const SmallMesh hanging = cloth_grid(10, 10, [&](int i, int j) {
+  const SmallMesh hanging = grid_mesh(10, 10, [&](int i, int j) {
     return Vec3d{i % 2 ? lo.x - 0.04 - 0.01 * std::cos(j) : lo.x, side_ys[i], side_zs[j]};
   });
   // Vertical, through the box.
-  const SmallMesh through = cloth_grid(10, 10, [&](int i, int j) {
+  const SmallMesh through = grid_mesh(10, 10, [&](int i, int j) {
     return Vec3d{0.21 + 0.05 * std::sin(1.3 * i + j), -0.3 + 0.17 * i, -0.9 + 0.16 * j};
   });
-  const SmallMesh flat = cloth_grid(16, 12, [&](int i, int j) {
-    return Vec3d{xs[i], ys[j], hi.z};
-  });
+  const SmallMesh flat = grid_mesh(16, 12, [&](int i, int j) { return Vec3d{xs[i], ys[j], hi.z}; });
 
   struct Scene {
     const char* name;

@@ -58,14 +58,6 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f,
   std::vector<std::string> names;
   names.reserve(objects.size());
   for (const ObjectInput& o : objects) names.push_back(csv_field(o.name));
-  const auto name_of = [&](int32_t object, const Pair& p) -> const std::string& {
-    if (object < 0 || static_cast<size_t>(object) >= names.size())
-      throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
-                          std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
-                          std::to_string(object) + "; the scene has " +
-                          std::to_string(names.size()));
-    return names[object];
-  };
   std::string row;
   const auto write_row = [&](const Pair& p) {
     char* q = after_frame + 1;
@@ -85,9 +77,9 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f,
     }
     row.assign(line, q);
     row += ',';
-    row += name_of(p.object_a, p);
+    row += pair_object_name(names, f, p, p.object_a);
     row += ',';
-    row += name_of(p.object_b, p);
+    row += pair_object_name(names, f, p, p.object_b);
     row += '\n';
     out.write(row.data(), static_cast<std::streamsize>(row.size()));
   };

@@ -244,14 +244,6 @@ std::string pairs_array(const FrameRecord& f, int level, std::span<const std::st
     const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
     out.append(number, end);
   };
-  const auto name_of = [&](int32_t object, const Pair& p) -> const std::string& {
-    if (object < 0 || static_cast<size_t>(object) >= names.size())
-      throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
-                          std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
-                          std::to_string(object) + "; the scene has " +
-                          std::to_string(names.size()));
-    return names[object];
-  };
   for (size_t i = 0; i < pairs.size(); ++i) {
     const Pair& p = pairs[i];
     out += i == 0 ? open_first : open_next;
@@ -264,9 +256,9 @@ std::string pairs_array(const FrameRecord& f, int level, std::span<const std::st
     add_number(p.poly_b);
     if (scene) {
       out += before_object_a;
-      out += name_of(p.object_a, p);
+      out += pair_object_name(names, f, p, p.object_a);
       out += before_object_b;
-      out += name_of(p.object_b, p);
+      out += pair_object_name(names, f, p, p.object_b);
     }
     out += close;
   }

@@ -49,6 +49,15 @@ double FrameRecord::max_depth() const {
   return depth;
 }
 
+const std::string& pair_object_name(std::span<const std::string> names, const FrameRecord& f,
+                                    const Pair& p, int32_t object) {
+  if (object < 0 || static_cast<size_t>(object) >= names.size())
+    throw InternalError("report: frame " + std::to_string(f.frame) + ": pair (" +
+                        std::to_string(p.a) + ", " + std::to_string(p.b) + ") names object " +
+                        std::to_string(object) + "; the scene has " + std::to_string(names.size()));
+  return names[object];
+}
+
 FrameRecord make_frame_record(int64_t frame, std::string file, const detect::FrameResult& result,
                               std::span<const int32_t> source_polygon, int32_t vertices,
                               int64_t polygons) {

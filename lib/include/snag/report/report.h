@@ -124,6 +124,12 @@ struct FrameRecord {
 /// frame record takes from its result, single mesh or scene).
 void copy_check_counts(const detect::FrameResult& result, FrameRecord& record);
 
+/// The entry of `names` (one per scene object, as a writer quotes them) of object `object` of
+/// pair `p` in frame `f`; InternalError naming the frame and the pair when the scene has no
+/// such object. What the CSV and JSON writers put in a scene pair's object columns.
+const std::string& pair_object_name(std::span<const std::string> names, const FrameRecord& f,
+                                    const Pair& p, int32_t object);
+
 /// Builds a frame record from a checker's result. `source_polygon[t]` is triangle t's face id
 /// in the file (Mesh::source_polygon, one entry per triangle).
 FrameRecord make_frame_record(int64_t frame, std::string file, const detect::FrameResult& result,
