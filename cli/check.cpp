@@ -215,7 +215,8 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("-j,--threads", o.threads, "Worker threads; 0 uses every core")
+  cmd->add_option("-j,--threads", o.threads,
+                  "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core")
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
