@@ -34,19 +34,26 @@ SNAG_HD_INLINE void refit_internal(int32_t node, TreeView tree) {
   tree.boxes[node] = geom::merge(tree.boxes[2 * node + 1], tree.boxes[2 * node + 2]);
 }
 
+/// The first node of the level below `node`'s (2^31 - 1 under a node of level 30, the deepest a
+/// tree of int32 nodes has).
+SNAG_HD_INLINE int32_t level_end(int32_t node) {
+  return static_cast<int32_t>((2u << CompleteTree::level_of(node)) - 1u);
+}
+
 /// Where walk_subtree goes from node i: its left child `left` when i is `internal` and
 /// overlaps, else `skip`, the next subtree in depth-first order; `last` when there is none
-/// under the walk's root (at root_level).
+/// under the walk's root.
 struct WalkStep {
   int32_t left, skip;
   bool internal, last;
 };
 
-SNAG_HD_INLINE WalkStep walk_step(int32_t i, int32_t first_leaf, int root_level) {
+/// `below_root` is the first node of the level under the walk's root: a next subtree that
+/// starts before it is at the root's level or above, so outside the root's subtree.
+SNAG_HD_INLINE WalkStep walk_step(int32_t i, int32_t first_leaf, int32_t below_root) {
   const uint32_t j = static_cast<uint32_t>(i) + 1;
-  const int climb = count_trailing_zeros(~j);
-  return {2 * i + 1, static_cast<int32_t>(j >> climb), i < first_leaf,
-          climb >= floor_log2(j) - root_level};
+  const auto skip = static_cast<int32_t>(j >> count_trailing_zeros(~j));
+  return {2 * i + 1, skip, i < first_leaf, skip < below_root};
 }
 
 /// Walks the subtree under `root` depth-first without a stack: test(node) says whether a
@@ -58,16 +65,17 @@ SNAG_HD_INLINE WalkStep walk_step(int32_t i, int32_t first_leaf, int root_level)
 /// numbering j = i + 1, left children are even and the parent of j is j >> 1, so climbing out
 /// of t right children and stepping to the sibling is (j >> t) + 1 in 1-based terms, (j >> t)
 /// in 0-based ones, with t the number of trailing ones of j. The walk ends when that climb
-/// would reach the subtree's root.
+/// would reach the subtree's root: when the next subtree's level (that of 0-based node s is
+/// floor(log2(s + 1))) is not below the root's, which is s < level_end(root).
 template <class Test, class AtLeaf>
 SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test,
                                  AtLeaf&& at_leaf) {
   const int32_t first_leaf = tree.shape.leaf_count - 1;
-  const int root_level = CompleteTree::level_of(root);
+  const int32_t below_root = level_end(root);
   int32_t i = root;
   while (true) {
     const bool hit = test(i);
-    const WalkStep step = walk_step(i, first_leaf, root_level);
+    const WalkStep step = walk_step(i, first_leaf, below_root);
     if (hit & !step.internal) at_leaf(i);
     const bool descend = hit & step.internal;
     if (!descend & step.last) break;
@@ -83,11 +91,11 @@ template <class Overlaps, class AtLeaf>
 SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root, Overlaps&& overlaps,
                                             AtLeaf&& at_leaf) {
   const int32_t first_leaf = tree.shape.leaf_count - 1;
-  const int root_level = CompleteTree::level_of(root);
+  const int32_t below_root = level_end(root);
   int32_t i = root;
   geom::Box3f box = tree.boxes[root];
   while (true) {
-    const WalkStep step = walk_step(i, first_leaf, root_level);
+    const WalkStep step = walk_step(i, first_leaf, below_root);
     // A successor that does not exist reads node i again (in cache) rather than branching.
     const geom::Box3f left_box = tree.boxes[step.internal ? step.left : i];
     const geom::Box3f skip_box = tree.boxes[step.last ? i : step.skip];
