@@ -50,11 +50,15 @@ class CudaBackendImpl final : public CudaBackend {
     cudaDeviceProp prop{};
     SNAG_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
     device_name_ = prop.name;
+    // Kernels whose item count is known only on the device stride over it with this many blocks
+    // at most: about one full wave of 256-thread blocks.
+    max_blocks_ = static_cast<unsigned>(std::max(prop.multiProcessorCount, 1)) * 8u;
     stream_ = std::make_unique<Stream>();
     upload_stream_ = std::make_unique<Stream>();
     configure_kernels();
     counters_.reserve(1);
     counters_host_.reserve(1);
+    scan_counters_host_.reserve(1);
   }
 
   ~CudaBackendImpl() override {
@@ -82,6 +86,8 @@ class CudaBackendImpl final : public CudaBackend {
 
   void set_topology(const detect::Topology& topology) override {
     drop_staged_positions();  // its buffers may be reallocated below
+    speculation_ = {};
+    last_detect_ = {};
     topology_ = &topology;
     const cudaStream_t s = stream();
     DeviceTopology& d = topo_;
@@ -238,8 +244,8 @@ class CudaBackendImpl final : public CudaBackend {
         launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(p),
                                part_size(p), mapped(scan_degenerate_host_.data()),
                                mapped(scan_uncertain_host_.data()), counters_.data(), s);
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(counters_host_.data(), counters_.data(), sizeof(FrameCounters),
-                                    cudaMemcpyDeviceToHost, s));
+    SNAG_CUDA_CHECK(cudaMemcpyAsync(scan_counters_host_.data(), counters_.data(),
+                                    sizeof(FrameCounters), cudaMemcpyDeviceToHost, s));
     std::vector<int32_t> ahead;
     for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
       if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
@@ -249,13 +255,14 @@ class CudaBackendImpl final : public CudaBackend {
       trees_[p]->queue_quality(s);
     }
     timer_.stop_async(s);
+    speculate_detect();
     times_.scan = timer_.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
     for (int32_t p : ahead) {
       part_[p].quality = trees_[p]->queued_quality();
       part_[p].quality_ready = true;
     }
-    const FrameCounters c = *counters_host_.data();
+    const FrameCounters c = *scan_counters_host_.data();
     scan.degenerate.assign(scan_degenerate_host_.data(),
                            scan_degenerate_host_.data() + c.degenerate);
     scan.uncertain.assign(scan_uncertain_host_.data(),
@@ -269,6 +276,7 @@ class CudaBackendImpl final : public CudaBackend {
   void build_part(int32_t p) override {
     require_topology();
     PartState& part = part_[p];
+    ++builds_;  // a detect queued ahead read the tree this replaces
     part.tree_built = true;
     part.tree_version = part.version;
     part.planes_version = part.version;
@@ -457,6 +465,29 @@ class CudaBackendImpl final : public CudaBackend {
 
   /// The frame's degenerate flags and edge ownership on the device.
   const uint8_t* prepare_degenerate(std::span<const int32_t> degenerate);
+  void queue_detect(detect::FilterUse use, std::span<const int32_t> checks, const uint8_t* owned);
+  void speculate_detect();
+  std::vector<uint64_t> part_versions() const {
+    std::vector<uint64_t> versions(part_.size());
+    for (size_t p = 0; p < part_.size(); ++p) versions[p] = part_[p].version;
+    return versions;
+  }
+
+  /// A detect_checks call: its checks and the filter's use.
+  struct DetectCall {
+    bool valid = false;
+    detect::FilterUse use = detect::FilterUse::certify;
+    std::vector<int32_t> checks;
+  };
+  /// A detect queued ahead by the scan (speculate_detect) and what it assumed.
+  struct Speculation {
+    bool queued = false;
+    DetectCall call;
+    std::vector<int32_t> degenerate;  ///< flagged_ then
+    uint64_t builds = 0;              ///< builds_ then
+    const geom::Vec3d* positions = nullptr;
+    std::vector<uint64_t> versions;  ///< each part's
+  };
 
   SelectDevice select_;
   int device_;
@@ -493,7 +524,13 @@ class CudaBackendImpl final : public CudaBackend {
   PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
-  PinnedBuffer<FrameCounters> counters_host_;
+  PinnedBuffer<FrameCounters> counters_host_;       // the detect's, written by finish_kernel
+  PinnedBuffer<FrameCounters> scan_counters_host_;  // the scan's, apart: a detect may follow it
+  DetectCall last_detect_;
+  Speculation speculation_;
+  uint64_t builds_ = 0;
+  unsigned max_blocks_ = 1;
+  EventTimer detect_timer_;
   DeviceBuffer<uint64_t> listed_;  // a check's candidate pairs, from its walk to its tests
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
@@ -537,19 +574,15 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
   return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
 }
 
-detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> degenerate,
-                                                     detect::FilterUse use,
-                                                     std::span<const int32_t> checks) {
-  require_topology();
-  detect::FilteredFrame frame;
-  const int32_t n = topo_.triangle_count;
-  if (n == 0) return frame;
+/// One run of a frame's checks queued whole, without a wait: planes where no refit or build
+/// computed them, then per check its walk and pair tests, the expansion into the pair set, and
+/// (when the frame's results fit one block) the sort straight into host memory. Buffers are
+/// sized by earlier frames; a count past a capacity is counted, not stored (see detect_checks).
+void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_t> checks,
+                                   const uint8_t* owned) {
   const cudaStream_t s = stream();
-  const auto start = Clock::now();
-  timer_.start(s);
-
-  const uint8_t* owned = prepare_degenerate(degenerate);
-  // The planes of the parts the checks read, where no refit or build computed them.
+  const int32_t n = topo_.triangle_count;
+  detect_timer_.start(s);
   for (int32_t c : checks)
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b}) {
       PartState& part = part_[p];
@@ -567,62 +600,101 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   inputs.topology.triangle_count = n;
   inputs.topology.edge_count = topo_.edge_count;
   inputs.degenerate = topo_.degenerate.data();
-  const int key_bits = 2 * pair_bits_;
-  const int task_bits = 32 + edge_bits_;
-  FrameCounters* host_counters = counters_host_.data();
+  ResultBuffers results;
+  results.hits = hits_.data();
+  results.uncertain = uncertain_.data();
+  results.duplicates = duplicates_.data();
+  results.hit_capacity = hits_.capacity();
+  results.uncertain_capacity = uncertain_.capacity();
+  results.duplicate_capacity = duplicates_.capacity();
+  results.counters = counters_.data();
+  results.edge_face_offsets = topo_.edge_face_offsets.data();
+  PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
+              pair_keys_.capacity()};
+  const CandidateList listed{listed_.data(), listed_.capacity()};
+  HostResults out = host_results_;
+  out.limit = finish_limit_;
+  SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
+  SNAG_CUDA_CHECK(
+      cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
+  const bool time_each = checks.size() > 1;
+  for (size_t i = 0; i < checks.size(); ++i) {
+    const detect::PartCheck check = topology_->checks[checks[i]];
+    if (time_each) check_timers_[i]->start(s);
+    // Each check lists its candidates from the start of the list.
+    SNAG_CUDA_CHECK(cudaMemsetAsync(&counters_.data()->listed, 0, sizeof(unsigned long long), s));
+    if (check.self()) {
+      if (part_size(check.a) > 0)
+        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, listed, results,
+                          use, max_blocks_, s);
+    } else {
+      // One thread per leaf of the larger part, walking the smaller one's tree.
+      const bool a_larger = part_size(check.a) >= part_size(check.b);
+      const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
+      launch_cross_check(trees_[big]->view(), part_begin(big), trees_[small]->view(),
+                         part_begin(small), inputs, listed, results, use, max_blocks_, s);
+    }
+    if (time_each) check_timers_[i]->stop_async(s);
+  }
+  narrow_timer_.stop_async(s);
+  launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
+                counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),
+                topo_.degenerate.data(), pair_bits_, current_positions_, topo_.triangles.data(),
+                set, max_blocks_, s);
+  launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), 2 * pair_bits_,
+                32 + edge_bits_, out, s);
+  detect_timer_.stop_async(s);
+}
 
-  // The whole frame is queued before the one wait: narrow phase, expansion into the pair set,
-  // and (when the frame's results fit one block) the sort straight into host memory. Buffers
-  // are sized by earlier frames; when one overflowed, the counts say by how much: grow, run
-  // again. No pair is lost, and a sequence allocates only while its counts grow.
+/// Queued at the end of the scan, before its wait, so that the device goes on from the scan
+/// to the checks while the host reads the scan and decides: the last frame's checks, with its
+/// filter use and its degenerate triangles (usually none, and then this frame's scan finds
+/// none either). Only when every checked part's tree fits the current positions (the refits
+/// queued ahead). detect_checks takes it when its call turns out to be the one assumed and no
+/// tree was rebuilt in between; else it queues the frame again (the stream orders the runs,
+/// and each run starts by clearing what it fills).
+void CudaBackendImpl::speculate_detect() {
+  speculation_.queued = false;
+  if (!last_detect_.valid) return;
+  for (int32_t c : last_detect_.checks)
+    for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b})
+      if (part_size(p) > 0 && (!part_[p].tree_built || part_[p].tree_version != part_[p].version))
+        return;
+  const uint8_t* owned =
+      flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
+  queue_detect(last_detect_.use, last_detect_.checks, owned);
+  speculation_.queued = true;
+  speculation_.call = last_detect_;
+  speculation_.degenerate = flagged_;
+  speculation_.builds = builds_;
+  speculation_.positions = current_positions_;
+  speculation_.versions = part_versions();
+}
+
+detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> degenerate,
+                                                     detect::FilterUse use,
+                                                     std::span<const int32_t> checks) {
+  require_topology();
+  detect::FilteredFrame frame;
+  if (topo_.triangle_count == 0) return frame;
+  const auto start = Clock::now();
+  const bool speculated = speculation_.queued && speculation_.call.use == use &&
+                          std::ranges::equal(speculation_.call.checks, checks) &&
+                          std::ranges::equal(speculation_.degenerate, degenerate) &&
+                          speculation_.builds == builds_ &&
+                          speculation_.positions == current_positions_ &&
+                          speculation_.versions == part_versions();
+  speculation_.queued = false;
+  const uint8_t* owned = prepare_degenerate(degenerate);
+  if (!speculated) queue_detect(use, checks, owned);
+  last_detect_ = {true, use, std::vector<int32_t>(checks.begin(), checks.end())};
+
+  // The one wait. When a buffer overflowed, the counts say by how much: grow, run again. No
+  // pair is lost, and a sequence allocates only while its counts grow.
   FrameCounters c{};
   for (;;) {
-    ResultBuffers results;
-    results.hits = hits_.data();
-    results.uncertain = uncertain_.data();
-    results.duplicates = duplicates_.data();
-    results.hit_capacity = hits_.capacity();
-    results.uncertain_capacity = uncertain_.capacity();
-    results.duplicate_capacity = duplicates_.capacity();
-    results.counters = counters_.data();
-    results.edge_face_offsets = topo_.edge_face_offsets.data();
-    PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
-                pair_keys_.capacity()};
-    const CandidateList listed{listed_.data(), listed_.capacity()};
-    HostResults out = host_results_;
-    out.limit = finish_limit_;
-    SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    SNAG_CUDA_CHECK(
-        cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
-    const bool time_each = checks.size() > 1;
-    for (size_t i = 0; i < checks.size(); ++i) {
-      const detect::PartCheck check = topology_->checks[checks[i]];
-      if (time_each) check_timers_[i]->start(s);
-      // Each check lists its candidates from the start of the list.
-      SNAG_CUDA_CHECK(cudaMemsetAsync(&counters_.data()->listed, 0, sizeof(unsigned long long), s));
-      if (check.self()) {
-        if (part_size(check.a) > 0)
-          launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, listed, results,
-                            use, s);
-      } else {
-        // One thread per leaf of the larger part, walking the smaller one's tree.
-        const bool a_larger = part_size(check.a) >= part_size(check.b);
-        const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
-        launch_cross_check(trees_[big]->view(), part_begin(big), trees_[small]->view(),
-                           part_begin(small), inputs, listed, results, use, s);
-      }
-      if (time_each) check_timers_[i]->stop_async(s);
-    }
-    narrow_timer_.stop_async(s);
-    launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
-                  counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),
-                  topo_.degenerate.data(), pair_bits_, current_positions_, topo_.triangles.data(),
-                  set, s);
-    launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), key_bits,
-                  task_bits, out, s);
-    timer_.stop_async(s);
-    timer_.elapsed();  // the wait
-    c = *host_counters;
+    detect_timer_.elapsed();
+    c = *counters_host_.data();
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
         c.listed_most <= listed_.capacity())
@@ -630,15 +702,16 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits.
     ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
                            grown(c.expanded + c.duplicates), grown(c.listed_most));
-    timer_.start(s);
+    queue_detect(use, checks, owned);
   }
   collect_times();
   {
     float ms = 0;
-    SNAG_CUDA_CHECK(cudaEventElapsedTime(&ms, timer_.start_event(), narrow_timer_.stop_event()));
+    SNAG_CUDA_CHECK(
+        cudaEventElapsedTime(&ms, detect_timer_.start_event(), narrow_timer_.stop_event()));
     times_.traverse = ms;
   }
-  times_.classify = timer_.elapsed() - times_.traverse;
+  times_.classify = detect_timer_.elapsed() - times_.traverse;
   frame.traverse_seconds = seconds_since(start);
   // Device time of each check (a single one: the traversal's, memsets included).
   for (size_t i = 0; i < checks.size(); ++i)
@@ -649,6 +722,8 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   const auto classify_start = Clock::now();
   // Frames too large for one block: CUB's device-wide sorts, now that the counts are known.
   const bool large_pairs = c.pairs > finish_limit_, large_tasks = c.uncertain > finish_limit_;
+  const cudaStream_t s = stream();
+  const int key_bits = 2 * pair_bits_, task_bits = 32 + edge_bits_;
   const uint64_t* keys = host_keys_.data();
   const uint8_t* statuses = host_status_.data();
   const uint64_t* tasks = host_uncertain_.data();

@@ -3,6 +3,8 @@
 #include <cooperative_groups.h>
 #include <cooperative_groups/scan.h>
 
+#include <algorithm>
+
 #include <cub/block/block_radix_sort.cuh>
 
 #include "launch.cuh"
@@ -169,21 +171,22 @@ __global__ void __launch_bounds__(kNarrowBlock)
   lister.finish();
 }
 
-/// The pair tests of one check, one thread per listed (t, leaf of `walked`) pair: the leaf's
-/// triangle, `walked_base` added, is x; pairs with a degenerate triangle are left out, the
-/// others tested with their shared corners (detect::test_candidate_pair). The grid covers the
-/// list's capacity, so it is queued before the count is known; threads past the count do
-/// nothing.
+/// The pair tests of one check, one per listed (t, leaf of `walked`) pair: the leaf's triangle,
+/// `walked_base` added, is x; pairs with a degenerate triangle are left out, the others tested
+/// with their shared corners (detect::test_candidate_pair). The kernel is queued before the
+/// walk's count is known: a fixed grid (launch_counted) strides over the listed pairs.
 template <detect::FilterUse use>
 __global__ void __launch_bounds__(kBlock)
     pair_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base, CandidateList listed,
                      ResultBuffers out) {
   DeviceSink sink{out};
   unsigned long long candidates = 0;
-  const auto i = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long listed_count = out.counters->listed;
-  if (i == 0) atomicMax(&out.counters->listed_most, listed_count);
-  if (i < min(listed_count, listed.capacity)) {
+  if (first == 0) atomicMax(&out.counters->listed_most, listed_count);
+  const unsigned long long tested = min(listed_count, listed.capacity);
+  for (unsigned long long i = first; i < tested; i += stride) {
     const uint64_t pair = listed.pairs[i];
     const auto t = static_cast<int32_t>(pair >> 32);
     const auto leaf = static_cast<int32_t>(pair & 0xffffffffu);
@@ -223,30 +226,34 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
                        : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
 }
 
+/// The hits' pairs and the duplicated faces into the pair set, one item each, hits first; a
+/// fixed grid (launch_counted) strides over the stored items. Past a capacity the narrow phase
+/// counted without storing: the host grows the buffers and runs the frame again.
 __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capacity,
                               const uint64_t* duplicates, unsigned long long duplicate_capacity,
                               FrameCounters* counters, const int32_t* offsets, const int32_t* faces,
                               const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
                               const geom::Tri* triangles, PairSet set) {
-  const unsigned long long i =
-      static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
-  // Past a capacity the narrow phase counted without storing: the host runs the frame again.
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long hit_count = min(counters->hits, hit_capacity);
-  const unsigned long long duplicate_count = min(counters->duplicates, duplicate_capacity);
-  if (i < hit_capacity) {
-    if (i >= hit_count) return;
-    const int32_t edge = static_cast<int32_t>(hits[i] >> 32);
-    const int32_t triangle = static_cast<int32_t>(hits[i] & 0xffffffffu);
-    for (int32_t j = offsets[edge]; j < offsets[edge + 1]; ++j) {
-      const int32_t face = faces[j];
-      if (face == triangle || degenerate[face]) continue;
-      const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) |
-                           static_cast<uint64_t>(max(face, triangle));
-      insert_pair(key, bits, positions, triangles, set, counters);
+  const unsigned long long items = hit_count + min(counters->duplicates, duplicate_capacity);
+  for (unsigned long long i = first; i < items; i += stride) {
+    if (i < hit_count) {
+      const int32_t edge = static_cast<int32_t>(hits[i] >> 32);
+      const int32_t triangle = static_cast<int32_t>(hits[i] & 0xffffffffu);
+      for (int32_t j = offsets[edge]; j < offsets[edge + 1]; ++j) {
+        const int32_t face = faces[j];
+        if (face == triangle || degenerate[face]) continue;
+        const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) |
+                             static_cast<uint64_t>(max(face, triangle));
+        insert_pair(key, bits, positions, triangles, set, counters);
+      }
+    } else {
+      const uint64_t d = duplicates[i - hit_count];
+      insert_pair(((d >> 32) << bits) | (d & 0xffffffffu), bits, positions, triangles, set,
+                  counters);
     }
-  } else if (i - hit_capacity < duplicate_count) {
-    const uint64_t d = duplicates[i - hit_capacity];
-    insert_pair(((d >> 32) << bits) | (d & 0xffffffffu), bits, positions, triangles, set, counters);
   }
 }
 
@@ -303,9 +310,27 @@ __device__ void sort_tasks(const uint64_t* uncertain, unsigned long long count, 
   }
 }
 
+/// Calls sort(Items<k>{}) with the fewest keys per thread k of 1, 2, 4 or kFinishItems that
+/// hold `count` keys in one block (a sort's passes cost in proportion to k).
+template <int k>
+struct Items {
+  static constexpr int value = k;
+};
+template <class Sort>
+__device__ void sort_with_fewest_items(unsigned long long count, Sort&& sort) {
+  constexpr unsigned long long threads = kFinishThreads;
+  if (count <= threads)
+    sort(Items<1>{});
+  else if (count <= 2 * threads)
+    sort(Items<2>{});
+  else if (count <= 4 * threads)
+    sort(Items<4>{});
+  else
+    sort(Items<kFinishItems>{});
+}
+
 /// The frame's results to host memory: small sets sorted in shared memory (keys are distinct,
-/// so the order is total and the block's output is the device-wide sort's), each with the
-/// fewest keys per thread that hold it (a sort's passes cost in proportion), the counters last.
+/// so the order is total and the block's output is the device-wide sort's), the counters last.
 __global__ void __launch_bounds__(kFinishThreads)
     finish_kernel(const FrameCounters* counters, PairSet set, const uint64_t* uncertain,
                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
@@ -313,27 +338,14 @@ __global__ void __launch_bounds__(kFinishThreads)
   extern __shared__ __align__(16) unsigned char shared[];
   const FrameCounters c = *counters;
   const unsigned long long limit = min(out.limit, kFinishLimit);
-  constexpr unsigned long long threads = kFinishThreads;
-  if (c.pairs > 0 && c.pairs <= limit && c.pairs <= set.pair_capacity) {
-    if (c.pairs <= threads)
-      sort_pairs<1>(set, c.pairs, key_bits, out, shared);
-    else if (c.pairs <= 2 * threads)
-      sort_pairs<2>(set, c.pairs, key_bits, out, shared);
-    else if (c.pairs <= 4 * threads)
-      sort_pairs<4>(set, c.pairs, key_bits, out, shared);
-    else
-      sort_pairs<kFinishItems>(set, c.pairs, key_bits, out, shared);
-  }
-  if (c.uncertain > 0 && c.uncertain <= limit && c.uncertain <= uncertain_capacity) {
-    if (c.uncertain <= threads)
-      sort_tasks<1>(uncertain, c.uncertain, task_bits, out, shared);
-    else if (c.uncertain <= 2 * threads)
-      sort_tasks<2>(uncertain, c.uncertain, task_bits, out, shared);
-    else if (c.uncertain <= 4 * threads)
-      sort_tasks<4>(uncertain, c.uncertain, task_bits, out, shared);
-    else
-      sort_tasks<kFinishItems>(uncertain, c.uncertain, task_bits, out, shared);
-  }
+  if (c.pairs > 0 && c.pairs <= limit && c.pairs <= set.pair_capacity)
+    sort_with_fewest_items(c.pairs, [&](auto items) {
+      sort_pairs<decltype(items)::value>(set, c.pairs, key_bits, out, shared);
+    });
+  if (c.uncertain > 0 && c.uncertain <= limit && c.uncertain <= uncertain_capacity)
+    sort_with_fewest_items(c.uncertain, [&](auto items) {
+      sort_tasks<decltype(items)::value>(uncertain, c.uncertain, task_bits, out, shared);
+    });
   if (threadIdx.x == 0) *out.counters = c;
 }
 
@@ -358,16 +370,29 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 
 namespace {
 
+/// A launch whose item count is known only on the device, when it runs: a grid that covers
+/// `bound` items (a buffer's capacity) but no more than `max_blocks`, the kernel striding over
+/// the items the device counted. Capacities only grow: after one heavily folded frame, a grid
+/// sized by them would launch mostly idle blocks for every later one.
+template <class... Params, class... Args>
+void launch_counted(void (*kernel)(Params...), unsigned long long bound, unsigned max_blocks,
+                    cudaStream_t stream, Args&&... args) {
+  const unsigned long long needed = (bound + kBlock - 1) / kBlock;
+  const auto blocks = static_cast<unsigned>(std::max<unsigned long long>(
+      1, std::min<unsigned long long>(needed, max_blocks)));
+  kernel<<<blocks, kBlock, 0, stream>>>(static_cast<Params>(args)...);
+  SNAG_CUDA_CHECK_LAUNCH();
+}
+
 void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, int32_t walked_base,
                        const CandidateList& listed, const ResultBuffers& results,
-                       detect::FilterUse use, cudaStream_t stream) {
-  const auto items = static_cast<int64_t>(listed.capacity);
+                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (use == detect::FilterUse::certify)
-    launch(pair_test_kernel<detect::FilterUse::certify>, items, stream, inputs, walked, walked_base,
-           listed, results);
+    launch_counted(pair_test_kernel<detect::FilterUse::certify>, listed.capacity, max_blocks,
+                   stream, inputs, walked, walked_base, listed, results);
   else
-    launch(pair_test_kernel<detect::FilterUse::defer_all>, items, stream, inputs, walked,
-           walked_base, listed, results);
+    launch_counted(pair_test_kernel<detect::FilterUse::defer_all>, listed.capacity, max_blocks,
+                   stream, inputs, walked, walked_base, listed, results);
 }
 
 unsigned walk_blocks(const bvh::TreeView& tree) {
@@ -378,23 +403,24 @@ unsigned walk_blocks(const bvh::TreeView& tree) {
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const CandidateList& listed, const ResultBuffers& results,
-                       detect::FilterUse use, cudaStream_t stream) {
+                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
   self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs.degenerate,
                                                                    listed, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_pair_tests(inputs, tree, base, listed, results, use, stream);
+  launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
 
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
                         int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
-                        const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream) {
+                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
+                        cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
   cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
       tree, base_a, other, inputs.degenerate, listed, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_pair_tests(inputs, other, base_b, listed, results, use, stream);
+  launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
 
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
@@ -402,10 +428,10 @@ void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
                    FrameCounters* counters, const int32_t* edge_face_offsets,
                    const int32_t* edge_faces, const uint8_t* degenerate, int bits,
                    const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
-                   cudaStream_t stream) {
-  launch(expand_kernel, static_cast<int64_t>(hit_capacity + duplicate_capacity), stream, hits,
-         hit_capacity, duplicates, duplicate_capacity, counters, edge_face_offsets, edge_faces,
-         degenerate, bits, positions, triangles, set);
+                   unsigned max_blocks, cudaStream_t stream) {
+  launch_counted(expand_kernel, hit_capacity + duplicate_capacity, max_blocks, stream, hits,
+                 hit_capacity, duplicates, duplicate_capacity, counters, edge_face_offsets,
+                 edge_faces, degenerate, bits, positions, triangles, set);
 }
 
 void configure_kernels() {

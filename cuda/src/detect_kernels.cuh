@@ -113,36 +113,38 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// A part against itself, in two launches. The walk: one thread per leaf position of its tree
 /// (in leaf order; the tree's triangle ids plus `base` are the topology's), listing every later
 /// overlapping leaf into `listed`, counted in results.counters->listed (which the caller zeroes
-/// first). The pair tests: one thread per listed pair, through detect::test_candidate_pair
+/// first). The pair tests: one per listed pair, through detect::test_candidate_pair
 /// (shared corners from the ids; degenerate triangles left out). The listed pairs are the CPU's
 /// neighbour pairs and traversal candidates together, each once: triangles that share a vertex
 /// always have overlapping boxes. Listing first keeps the walk to box tests (a walk that tested
 /// its pairs, or loaded anything at its leaves, held its warp's other walks back each time),
 /// and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
-/// its own, so that the usual one carries no branch for it.
+/// its own, so that the usual one carries no branch for it. The pair tests run on at most
+/// `max_blocks` blocks (striding over the list when it is longer).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const CandidateList& listed, const ResultBuffers& results,
-                       detect::FilterUse use, cudaStream_t stream);
+                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream);
 
 /// Two parts, the same way: one thread per leaf of `tree` (part a, whose first triangle is
 /// base_a) listing the overlapping leaves of all of `other` (part b), then the pair tests of
 /// the list (parts share no vertex: no shared corners).
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
                         int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
-                        const ResultBuffers& results, detect::FilterUse use, cudaStream_t stream);
+                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
+                        cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with
 /// the double filter (detect::is_crossing) once each. Reads the counts from `counters` (the
-/// narrow phase's), so it can be queued before they are known: the grid covers the buffers'
-/// capacities, and entries past a count or past a capacity are not read.
+/// narrow phase's), so it can be queued before they are known: at most `max_blocks` blocks
+/// stride over the stored entries; entries past a count or past a capacity are not read.
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
                    const uint64_t* duplicates, unsigned long long duplicate_capacity,
                    FrameCounters* counters, const int32_t* edge_face_offsets,
                    const int32_t* edge_faces, const uint8_t* degenerate, int bits,
                    const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
-                   cudaStream_t stream);
+                   unsigned max_blocks, cudaStream_t stream);
 
 /// One block: when the frame's pairs and uncertain tests each fit in the block (and in
 /// out.limit), sorts them (pairs by key over key_bits, uncertain tests by (edge, triangle) over
