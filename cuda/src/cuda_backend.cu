@@ -465,6 +465,10 @@ class CudaBackendImpl final : public CudaBackend {
 
   /// The frame's degenerate flags and edge ownership on the device.
   const uint8_t* prepare_degenerate(std::span<const int32_t> degenerate);
+  /// Edge ownership on the device for the degenerate triangles flagged there (flagged_).
+  const uint8_t* flagged_owned_edges() const {
+    return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
+  }
   void queue_detect(detect::FilterUse use, std::span<const int32_t> checks, const uint8_t* owned);
   void speculate_detect();
   std::vector<uint64_t> part_versions() const {
@@ -571,7 +575,7 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
     }
     flagged_.assign(degenerate.begin(), degenerate.end());
   }
-  return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
+  return flagged_owned_edges();
 }
 
 /// One run of a frame's checks queued whole, without a wait: planes where no refit or build
@@ -660,9 +664,7 @@ void CudaBackendImpl::speculate_detect() {
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b})
       if (part_size(p) > 0 && (!part_[p].tree_built || part_[p].tree_version != part_[p].version))
         return;
-  const uint8_t* owned =
-      flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
-  queue_detect(last_detect_.use, last_detect_.checks, owned);
+  queue_detect(last_detect_.use, last_detect_.checks, flagged_owned_edges());
   speculation_.queued = true;
   speculation_.call = last_detect_;
   speculation_.degenerate = flagged_;
