@@ -119,6 +119,28 @@ TEST(Tree, BuildIsTheSameForEveryThreadCount) {
   EXPECT_EQ(one.triangle_at(), four.triangle_at());
 }
 
+TEST(Tree, QualityIsTheSameBitsForEveryThreadCountAndTheSumOfHalfAreas) {
+  for (int32_t n : {1, 2, 1025, 9000, 20000}) {
+    SCOPED_TRACE("n=" + std::to_string(n));
+    Soup soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.2);
+    Tree tree;
+    tree.build(soup.view(), 2);
+    const double one = tree.quality(1);
+    EXPECT_EQ(one, tree.quality(2));
+    EXPECT_EQ(one, tree.quality(4));
+    // The plain sum in node order, over the root's half area: the same up to rounding.
+    double sum = 0.0;
+    for (int32_t node = 0; node < n - 1; ++node) sum += geom::half_area(tree.boxes()[node]);
+    const double root = geom::half_area(tree.boxes()[0]);
+    if (n == 1) {
+      EXPECT_EQ(one, 0.0);
+    } else {
+      EXPECT_NEAR(one, sum / root, 1e-12 * sum / root);
+      EXPECT_GE(one, 1.0);  // the root's own half area is in the sum
+    }
+  }
+}
+
 TEST(Tree, BuildSplitsEachSegmentAlongTheLongestAxis) {
   // Triangles strung along x: sorted order along x must be recovered exactly.
   Soup soup;

@@ -91,10 +91,11 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   }
 }
 
-double Tree::quality() const {
+double Tree::quality(int threads) const {
   const int32_t blocks = quality_block_count(shape_);
   if (blocks == 0) return 0.0;
   std::vector<double> block_sums(static_cast<size_t>(blocks));
+#pragma omp parallel for num_threads(threads) schedule(static) if (blocks > kParallelLevel / kQualityBlock)
   for (int32_t block = 0; block < blocks; ++block)
     block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
   return quality_from_blocks(block_sums.data(), blocks, boxes_[0]);

@@ -186,11 +186,13 @@ FrameResult Checker::check(const FrameInput& input) {
       const auto start = Clock::now();
       backend_->refit_part(p);
       part.refit_seconds = seconds_since(start);
+      // Asked once: on the CPU the quality is a pass over every internal node.
+      last_quality_[p] = backend_->part_quality(p);
       if (settings_.rebuild == RebuildPolicy::automatic && built_quality_[p] > 0 &&
-          backend_->part_quality(p) > settings_.rebuild_threshold * built_quality_[p])
+          last_quality_[p] > settings_.rebuild_threshold * built_quality_[p])
         build(true);
     }
-    if (moved[p] || part.rebuilt) last_quality_[p] = backend_->part_quality(p);
+    if (part.rebuilt) last_quality_[p] = built_quality_[p];
     part.tree_quality = last_quality_[p];
     result.times.build += part.build_seconds;
     result.times.refit += part.refit_seconds;

@@ -83,7 +83,7 @@ class CpuBackend final : public Backend {
     trees_[part].refit(part_view(part), threads_);
   }
   double part_quality(int32_t part) override {
-    return trees_[part].quality();
+    return trees_[part].quality(threads_);
   }
 
   FilteredFrame detect_checks(std::span<const int32_t> degenerate, FilterUse use,

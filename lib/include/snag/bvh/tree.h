@@ -282,8 +282,9 @@ class Tree {
   /// time up to the root, each level in parallel.
   void refit(mesh::MeshView mesh, int threads);
   /// Sum of internal-node half areas over the root's half area (0 for a single leaf), summed
-  /// in the blocked order of quality_block_sum / quality_from_blocks.
-  double quality() const;
+  /// in the blocked order of quality_block_sum / quality_from_blocks, so the same bits for
+  /// every thread count.
+  double quality(int threads = 1) const;
 
   TreeView view() { return {shape_, boxes_.data(), triangle_at_.data()}; }
   const CompleteTree& shape() const { return shape_; }

@@ -27,25 +27,27 @@ SNAG_HD_INLINE float float_up(double x) {
   return __double2float_ru(x);
 }
 #else
-/// The float one unit in the last place below / above finite f, by its bit pattern (the
-/// library's nextafterf is an out-of-line call in the refit's innermost loop).
-inline float float_step(float f, bool up) {
-  if (f == 0.0f) return up ? FLT_TRUE_MIN : -FLT_TRUE_MIN;
+/// f moved one unit in the last place away from zero (`away`) or towards it, by its bit pattern.
+/// Without branches: whether a conversion rounded the wrong way is a coin toss per coordinate,
+/// and the refit's innermost loop mispredicted it. A zero that must step is always -0.0 when
+/// the step is down (a negative x converts to -0.0) and +0.0 when it is up, so that its step
+/// away from zero, to -+FLT_TRUE_MIN, follows the same rule.
+inline float float_step(float f, bool step, bool away) {
   uint32_t bits;
   std::memcpy(&bits, &f, sizeof bits);
-  bits += ((f > 0.0f) == up) ? 1u : static_cast<uint32_t>(-1);
+  bits += static_cast<uint32_t>(step) * (away ? 1u : ~0u);
   std::memcpy(&f, &bits, sizeof bits);
   return f;
 }
-/// The largest float not above x (x finite).
+/// The largest float not above x (x finite): down is away from zero for a negative float.
 inline float float_down(double x) {
   const float f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? float_step(f, false) : f;
+  return float_step(f, static_cast<double>(f) > x, std::signbit(f));
 }
-/// The smallest float not below x (x finite).
+/// The smallest float not below x (x finite): up is away from zero for a positive float.
 inline float float_up(double x) {
   const float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? float_step(f, true) : f;
+  return float_step(f, static_cast<double>(f) < x, !std::signbit(f));
 }
 #endif
 
