@@ -33,20 +33,22 @@ struct SequenceSettings {
   LoopTimes* times = nullptr;  ///< when given, filled with where the loop's time went
 };
 
-/// Reader threads for a run with `threads` workers. On the CPU the checker's threads do the
-/// heavy work and a quarter as many readers keep ahead of them (at least 1, at most 4); on a
-/// GPU the host mostly waits, reading is the work, and every thread but the checker's reads.
-/// Readers wait whenever the frames ahead fill their ring (readers + 2 frames).
+/// Reader threads for a run with `threads` workers. On the CPU a frame's reading costs about
+/// a fifteenth of its check on one thread (36K triangles: 1-2 ms against 15-30 ms), so one
+/// reader per 16 threads keeps ahead of the checker (at least 1, at most 4); on a GPU the host
+/// mostly waits, reading is the work, and every thread but the checker's reads. Readers wait
+/// whenever the frames ahead fill their ring (readers + 2 frames).
 int readers_for(int threads, bool gpu);
 
 /// The checker's worker threads in a run of `threads`. On the CPU with 8 threads or more, the
 /// readers' threads are taken out, so that the run stays within `threads`: OpenMP's workers
 /// spin between parallel regions, and readers that took their cores stalled the regions and
-/// were starved in turn (16 cores, 200 frames of 36K triangles: with the readers on top the
-/// loop waited 0.10-0.19 s for frames and took 1.84-1.98 times checking alone; with 12 workers
-/// and 4 readers, 0.01-0.02 s and 1.17-1.59 times). Below 8 threads, where a reader's core
-/// would be an eighth to a half of the check's, and on a GPU, where the host mostly waits, the
-/// readers come on top and the checker has all `threads`.
+/// were starved in turn. 16 cores of the H100 host, 200 frames of 36K triangles, snag check
+/// against checking alone on 16 threads: 2.05 times with 16 workers and a reader on top, 1.45
+/// with 12 workers and 4 readers, 1.26 with 14 and 2, 1.21 with 15 and 1 (whose loop checked
+/// as fast as the check alone). Below 8 threads, where a reader's core would be an eighth to a
+/// half of the check's, and on a GPU, where the host mostly waits, the readers come on top and
+/// the checker has all `threads`.
 int checker_threads_for(int threads, bool gpu);
 
 /// Reads `frames` ahead and checks them in order with `checker`:

@@ -52,7 +52,7 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   }
   const std::vector<std::string> cpu = row(r.out, "cpu ");
   ASSERT_EQ(cpu.size(), 8u);
-  EXPECT_EQ(cpu[0], "1");           // readers: a quarter of 2 threads, at least one
+  EXPECT_EQ(cpu[0], "1");           // readers: one per 16 threads, at least one
   EXPECT_GT(std::stod(cpu[3]), 0);  // snag check, seconds
   // Where the loop's time went: five shares, none negative, adding up to no more than the loop.
   const std::vector<std::string> loop = row(r.out, "cpu ", 1);

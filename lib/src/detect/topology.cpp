@@ -15,7 +15,10 @@ struct EdgeRecord {
   int32_t corner;  // the triangle's edge k joins corners k and k + 1
 };
 
-/// Lists the pairs of triangles around each vertex of valence at most kMaxListedValence.
+/// Lists the pairs of triangles around each vertex of valence at most kMaxListedValence, in
+/// (a, b) order without sorting the list: each triangle t gathers the later triangles of its
+/// listed corners' fans (a few dozen at most), sorts and dedupes those, and the triangles
+/// come in increasing id.
 void make_neighbor_pairs(Topology& topo) {
   const int32_t n = topo.triangle_count();
   std::vector<uint8_t> usable(static_cast<size_t>(n), 1);
@@ -33,25 +36,35 @@ void make_neighbor_pairs(Topology& topo) {
       for (int k = 0; k < 3; ++k) fan[fill[topo.triangles[t].v[k]]++] = t;
   topo.listed_vertex.assign(static_cast<size_t>(topo.vertex_count), 0);
   topo.every_vertex_listed = true;
+  for (int32_t v = 0; v < topo.vertex_count; ++v) {
+    if (offsets[v + 1] - offsets[v] > Topology::kMaxListedValence)
+      topo.every_vertex_listed = false;
+    else
+      topo.listed_vertex[v] = 1;
+  }
   std::vector<std::array<int32_t, 2>>& pairs = topo.neighbor_pairs;
   pairs.clear();
-  for (int32_t v = 0; v < topo.vertex_count; ++v) {
-    const int32_t begin = offsets[v], end = offsets[v + 1];
-    if (end - begin > Topology::kMaxListedValence) {
-      topo.every_vertex_listed = false;
-      continue;
+  topo.neighbor_shared.clear();
+  std::array<int32_t, 3 * Topology::kMaxListedValence> later;
+  for (int32_t t = 0; t < n; ++t) {
+    if (!usable[t]) continue;
+    const geom::Tri tri = topo.triangles[t];
+    size_t count = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = tri.v[k];
+      if (!topo.listed_vertex[v]) continue;
+      const int32_t* begin = fan.data() + offsets[v];
+      const int32_t* end = fan.data() + offsets[v + 1];
+      for (const int32_t* x = std::upper_bound(begin, end, t); x != end; ++x) later[count++] = *x;
     }
-    topo.listed_vertex[v] = 1;
-    for (int32_t i = begin; i < end; ++i)
-      for (int32_t j = i + 1; j < end; ++j) pairs.push_back({fan[i], fan[j]});
-  }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  topo.neighbor_shared.resize(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    uint32_t a_shared, b_shared;
-    shared_corners(topo.triangles[pairs[i][0]], topo.triangles[pairs[i][1]], a_shared, b_shared);
-    topo.neighbor_shared[i] = static_cast<uint8_t>(a_shared | b_shared << 3);
+    std::sort(later.begin(), later.begin() + count);
+    const auto unique_end = std::unique(later.begin(), later.begin() + count);
+    for (auto x = later.begin(); x != unique_end; ++x) {
+      uint32_t t_shared, x_shared;
+      shared_corners(tri, topo.triangles[*x], t_shared, x_shared);
+      pairs.push_back({t, *x});
+      topo.neighbor_shared.push_back(static_cast<uint8_t>(t_shared | x_shared << 3));
+    }
   }
 }
 
@@ -137,8 +150,12 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
   topo.triangle_edges.assign(static_cast<size_t>(n), {-1, -1, -1});
   topo.owned_edges.assign(static_cast<size_t>(n), 0);
 
-  std::vector<EdgeRecord> records;
-  records.reserve(static_cast<size_t>(n) * 3);
+  // The edges' records grouped by their smaller endpoint (a counting sort, stable: each
+  // group in increasing triangle id), then each small group ordered by the larger endpoint
+  // (insertion sort, stable): records in (u, v, triangle) order in linear time.
+  std::vector<EdgeRecord> unsorted;
+  unsorted.reserve(static_cast<size_t>(n) * 3);
+  std::vector<int32_t> group_begin(static_cast<size_t>(vertex_count) + 1, 0);
   for (int32_t t = 0; t < n; ++t) {
     const geom::Tri& tri = triangles[t];
     for (int k = 0; k < 3; ++k)
@@ -152,14 +169,23 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
     }
     for (int k = 0; k < 3; ++k) {
       const int32_t a = tri.v[k], b = tri.v[(k + 1) % 3];
-      records.push_back({std::min(a, b), std::max(a, b), t, k});
+      unsorted.push_back({std::min(a, b), std::max(a, b), t, k});
+      ++group_begin[std::min(a, b) + 1];
     }
   }
-  std::sort(records.begin(), records.end(), [](const EdgeRecord& x, const EdgeRecord& y) {
-    if (x.u != y.u) return x.u < y.u;
-    if (x.v != y.v) return x.v < y.v;
-    return x.triangle < y.triangle;
-  });
+  for (int32_t v = 0; v < vertex_count; ++v) group_begin[v + 1] += group_begin[v];
+  std::vector<EdgeRecord> records(unsorted.size());
+  {
+    std::vector<int32_t> fill(group_begin.begin(), group_begin.end() - 1);
+    for (const EdgeRecord& rec : unsorted) records[fill[rec.u]++] = rec;
+  }
+  for (int32_t u = 0; u < vertex_count; ++u)
+    for (int32_t r = group_begin[u] + 1; r < group_begin[u + 1]; ++r) {
+      const EdgeRecord rec = records[r];
+      int32_t to = r;
+      for (; to > group_begin[u] && records[to - 1].v > rec.v; --to) records[to] = records[to - 1];
+      records[to] = rec;
+    }
 
   topo.edge_face_offsets.push_back(0);
   for (size_t r = 0; r < records.size(); ++r) {
