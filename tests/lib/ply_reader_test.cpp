@@ -389,6 +389,24 @@ TEST(PlyReader, RejectsAsciiNonNumbers) {
   std::string index = square(Enc::ascii);
   index.replace(index.rfind("\n3 ") + 3, 1, "3.5");
   expect_contains(reject(index), "'3.5'");
+  // A number and text in one token, a sign and nothing, and two signs, as the OBJ reader
+  // rejects them; numbers are parsed straight from the text, so each must end its token.
+  for (const char* bad : {"1x", "+", "+-1", "1e", "--1"}) {
+    SCOPED_TRACE(bad);
+    std::string coordinate = square(Enc::ascii);
+    coordinate.replace(coordinate.find("end_header\n") + 11, 1, bad);
+    const InputError e = reject(coordinate);
+    expect_contains(e, "'" + std::string(bad) + "'");
+    expect_contains(e, "x coordinate of vertex 0");
+  }
+  std::string count = square(Enc::ascii);
+  count.replace(count.rfind("\n3 ") + 1, 1, "3x");
+  expect_contains(reject(count), "expected an integer corner count");
+  // The token may end at the end of the file.
+  std::string last = square(Enc::ascii);
+  while (last.back() == '\n' || last.back() == ' ') last.pop_back();
+  EXPECT_EQ(read_ply(last, "t.ply").triangles.size(),
+            read_ply(square(Enc::ascii), "t.ply").triangles.size());
 }
 
 TEST(PlyReader, RejectsMalformedHeaders) {

@@ -163,22 +163,6 @@ class ObjParser {
     mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
   }
 
-  /// std::from_chars for indices, with a plain digit loop for the usual case of at most 18
-  /// digits (no overflow possible), which is about twice as fast.
-  std::from_chars_result parse_index(const char* first, int64_t& value) const {
-    const char* q = first;
-    uint64_t v = 0;
-    while (q < end_ && q - first < 18 && static_cast<unsigned char>(*q - '0') < 10) {
-      v = v * 10 + static_cast<unsigned>(*q - '0');
-      ++q;
-    }
-    if (q > first && (q == end_ || static_cast<unsigned char>(*q - '0') >= 10)) {
-      value = static_cast<int64_t>(v);
-      return {q, std::errc()};
-    }
-    return std::from_chars(first, end_, value);
-  }
-
   void parse_face() {
     ++p_;
     corners_.clear();
@@ -189,7 +173,7 @@ class ObjParser {
       const char* start = p_;
       const char* first = (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-') ? p_ + 1 : p_;
       int64_t index = 0;
-      auto [ptr, ec] = parse_index(first, index);
+      auto [ptr, ec] = detail::parse_integer(first, end_, index);
       if (ec == std::errc::result_out_of_range) {
         fail("vertex index " + quote_token(start, end_) + " is out of range");
       }

@@ -656,26 +656,37 @@ class AsciiBody {
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
 
-  /// Moves to the next token, counting line ends on the way; fails at the end of the file.
-  const char* next_token(const Element& el, int64_t i) {
+  /// Moves to the start of the next token, counting line ends on the way; fails at the end of
+  /// the file.
+  const char* skip_to_token(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank_or_eol(*p_)) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
     if (p_ == end_) fail("file ends inside " + record_name(el, i) + "; expected more values");
-    const char* start = p_;
+    return p_;
+  }
+
+  /// Moves past the next token; returns its start.
+  const char* next_token(const Element& el, int64_t i) {
+    const char* start = skip_to_token(el, i);
     while (p_ < end_ && !is_blank_or_eol(*p_)) ++p_;
     return start;
   }
 
+  /// Whether a number parsed up to `ptr` is the whole token: the parse and the token end
+  /// together, so that each character is read once.
+  bool ends_token(const char* ptr) const { return ptr == end_ || is_blank_or_eol(*ptr); }
+
   int64_t next_integer(const Element& el, int64_t i, const Property& prop, const char* what) {
-    const char* start = next_token(el, i);
+    const char* start = skip_to_token(el, i);
     int64_t v = 0;
-    auto [ptr, ec] = std::from_chars(start, p_, v);
-    if (ec != std::errc() || ptr != p_) {
+    auto [ptr, ec] = detail::parse_integer(start, end_, v);
+    if (ec != std::errc() || !ends_token(ptr)) {
       fail(std::string("expected an integer ") + what + " for " + quote(prop.name) + " of " +
            record_name(el, i) + ", found " + quote_token(start, end_));
     }
+    p_ = ptr;
     return v;
   }
 
@@ -697,27 +708,33 @@ class AsciiBody {
         for (int64_t c = 0; c < n; ++c) next_token(el, i);
         continue;
       }
-      const char* start = next_token(el, i);
-      for (int axis = 0; axis < 3; ++axis) {
-        if (plan_.xyz[axis] != static_cast<int>(k)) continue;
-        const char* first = (*start == '+' && start + 1 < p_) ? start + 1 : start;
-        auto [ptr, ec] = fast_float::from_chars(first, p_, xyz[axis]);
-        if (ec != std::errc() || ptr != p_) {
-          fail(std::string("expected a number for the ") + "xyz"[axis] + " coordinate of " +
-               record_name(el, i) + ", found " + quote_token(start, end_));
-        }
-        if (!std::isfinite(xyz[axis])) {
-          fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
-               record_name(el, i) + " is not finite; expected a finite number");
-        }
-        // A `float` property holds what a float can: a value that rounds to infinity as a float
-        // (FLT_MAX plus half its ulp, 2^103, or more) is one a binary file could not hold. In
-        // range, the text's value is kept as written, in double precision.
-        if (prop.type == Scalar::f32 && std::fabs(xyz[axis]) >= 0x1.ffffffp+127) {
-          fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
-               record_name(el, i) + " does not fit its float property; expected a finite float");
-        }
+      int axis = 0;
+      while (axis < 3 && plan_.xyz[axis] != static_cast<int>(k)) ++axis;
+      if (axis == 3) {  // another property of the vertex: skipped
+        next_token(el, i);
+        continue;
       }
+      const char* start = skip_to_token(el, i);
+      // fast_float follows std::from_chars and rejects a leading '+', which some writers emit.
+      const char* first =
+          (*start == '+' && start + 1 < end_ && start[1] != '-') ? start + 1 : start;
+      auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[axis]);
+      if (ec != std::errc() || ptr == first || !ends_token(ptr)) {
+        fail(std::string("expected a number for the ") + "xyz"[axis] + " coordinate of " +
+             record_name(el, i) + ", found " + quote_token(start, end_));
+      }
+      if (!std::isfinite(xyz[axis])) {
+        fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+             record_name(el, i) + " is not finite; expected a finite number");
+      }
+      // A `float` property holds what a float can: a value that rounds to infinity as a float
+      // (FLT_MAX plus half its ulp, 2^103, or more) is one a binary file could not hold. In
+      // range, the text's value is kept as written, in double precision.
+      if (prop.type == Scalar::f32 && std::fabs(xyz[axis]) >= 0x1.ffffffp+127) {
+        fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+             record_name(el, i) + " does not fit its float property; expected a finite float");
+      }
+      p_ = ptr;
     }
     mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
   }

@@ -2,8 +2,11 @@
 // offending token in error messages. Private to lib/src/io.
 #pragma once
 
+#include <charconv>
+#include <cstdint>
 #include <cstring>
 #include <string>
+#include <system_error>
 
 namespace snag::io::detail {
 
@@ -20,6 +23,22 @@ inline const char* find_eol(const char* p, const char* end) {
   if (p >= end) return end;
   const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
   return nl ? static_cast<const char*>(nl) : end;
+}
+
+/// std::from_chars for an integer (an index, a count), with a plain digit loop for the usual
+/// case of at most 18 digits (no overflow possible), which is about twice as fast.
+inline std::from_chars_result parse_integer(const char* first, const char* end, int64_t& value) {
+  const char* q = first;
+  uint64_t v = 0;
+  while (q < end && q - first < 18 && static_cast<unsigned char>(*q - '0') < 10) {
+    v = v * 10 + static_cast<unsigned>(*q - '0');
+    ++q;
+  }
+  if (q > first && (q == end || static_cast<unsigned char>(*q - '0') >= 10)) {
+    value = static_cast<int64_t>(v);
+    return {q, std::errc()};
+  }
+  return std::from_chars(first, end, value);
 }
 
 /// The whitespace-delimited token starting at `p`, quoted, shortened past 40 characters so that
