@@ -294,9 +294,7 @@ std::string json_frame_element(const FrameRecord& frame, bool first,
   return text;
 }
 
-void write_report_json(std::ostream& out, const Report& run, const Summary& summary,
-                       const std::function<void(std::ostream&)>& write_files,
-                       const std::function<void(std::ostream&)>& write_frames) {
+void write_report_json_head(std::ostream& out, const Report& run) {
   const Settings& set = run.settings;
   const ordered_json settings = {
       {"backend", set.backend},
@@ -309,14 +307,20 @@ void write_report_json(std::ostream& out, const Report& run, const Summary& summ
       {"rebuild_threshold", set.rebuild_threshold},
       {"fail_on", std::string(to_string(set.fail_on))},
       {"frames", set.frames ? ordered_json(*set.frames) : ordered_json(nullptr)}};
-  const bool no_frames = summary.frames_checked == 0;
-
-  // The root object (level 0) with its members at level 1; inputs is spelled out member by
-  // member because its files array is written by the caller.
+  // The root object (level 0) with its members at level 1, up to the frames array's "[".
   out << "{\n";
   out << member("schema", std::string(json_schema), 1) << ",\n";
   out << member("snag", {{"version", run.snag_version}}, 1) << ",\n";
   out << member("settings", settings, 1) << ",\n";
+  out << indent(frames_level) << "\"frames\": [";
+}
+
+void write_report_json_tail(std::ostream& out, const Report& run, const Summary& summary,
+                            const std::function<void(std::ostream&)>& write_files) {
+  const bool no_frames = summary.frames_checked == 0;
+  if (!no_frames) out << '\n' << indent(frames_level);
+  out << "],\n";
+  // inputs is spelled out member by member because its files array is written by the caller.
   out << indent(1) << "\"inputs\": {\n";
   out << member("sequence", run.inputs.sequence, 2) << ",\n";
   out << member("ids", run.inputs.ids, 2) << ",\n";
@@ -328,11 +332,16 @@ void write_report_json(std::ostream& out, const Report& run, const Summary& summ
   if (run.inputs.scene()) out << ",\n" << member("objects", objects_json(run.inputs.objects), 2);
   out << "\n";
   out << indent(1) << "},\n";
-  out << indent(frames_level) << "\"frames\": ";
-  write_array(out, frames_level, no_frames, write_frames);
-  out << ",\n";
   out << member("summary", summary_json(run, summary), 1) << "\n";
   out << "}\n";
+}
+
+void write_report_json(std::ostream& out, const Report& run, const Summary& summary,
+                       const std::function<void(std::ostream&)>& write_files,
+                       const std::function<void(std::ostream&)>& write_frames) {
+  write_report_json_head(out, run);
+  write_frames(out);
+  write_report_json_tail(out, run, summary, write_files);
 }
 
 std::string report_json(const Report& report) {

@@ -1,5 +1,6 @@
 // report.json composed of pieces, so that ReportStream can write its two arrays that grow with
-// the run (inputs.files and frames) as frames finish and everything else at the end, while the
+// the run (frames, into the file itself, and inputs.files) as frames finish and everything
+// else at the end, while the
 // bytes stay those nlohmann's dump(2) gives for the whole document (two-space indentation,
 // "key": value, one element or member per line, [] for an empty array). Private to snag::lib;
 // json.h's report_json is the same composition in memory.
@@ -25,13 +26,23 @@ std::string json_file_element(const std::string& file, bool first);
 std::string json_frame_element(const FrameRecord& frame, bool first,
                                std::span<const ObjectInput> objects);
 
-/// Writes report.json: `run`'s head (version, settings, inputs) and totals (builds, rebuilds,
-/// wall seconds), the elements `write_files` and `write_frames` write (what the *_element
-/// functions gave, in order), and `summary`, whose frames_checked says whether the two arrays
-/// have elements. run.frames is not read; run.inputs.objects, when not empty, adds
-/// inputs.objects and the summary's scene members.
+/// Writes report.json: `run`'s head (version, settings), the frames elements `write_frames`
+/// writes (what json_frame_element gave, in order), then the inputs with the inputs.files
+/// elements `write_files` writes (json_file_element), and `summary`, whose frames_checked says
+/// whether the two arrays have elements, with `run`'s totals (builds, rebuilds, wall seconds).
+/// The inputs follow the frames because a run knows them only at its end (the files read,
+/// whose ids, the vertices welded), while the frames, most of the bytes, can then go straight
+/// to the file as they finish. run.frames is not read; run.inputs.objects, when not empty,
+/// adds inputs.objects and the summary's scene members.
 void write_report_json(std::ostream& out, const Report& run, const Summary& summary,
                        const std::function<void(std::ostream&)>& write_files,
                        const std::function<void(std::ostream&)>& write_frames);
+
+/// write_report_json in two parts around the frames elements, for a file written as the run
+/// goes: the head, up to and including the frames array's "[" (needs only run's version and
+/// settings), and the tail, from the array's "]" to the end.
+void write_report_json_head(std::ostream& out, const Report& run);
+void write_report_json_tail(std::ostream& out, const Report& run, const Summary& summary,
+                            const std::function<void(std::ostream&)>& write_files);
 
 }  // namespace snag::report

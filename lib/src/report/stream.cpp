@@ -37,23 +37,22 @@ void append_scratch(const StagedFile& piece, std::ostream& out) {
 
 }  // namespace
 
-/// The three reports' temporaries and report.json's two spools. The reports are created first,
-/// in the order write_reports has always renamed them.
+/// The three reports' temporaries and report.json's spool of file names. The reports are created
+/// first, in the order write_reports has always renamed them.
 struct ReportStream::Files {
   explicit Files(const fs::path& dir)
       : staged(dir),
         pairs_csv(staged.create("pairs.csv")),
         frames_csv(staged.create("frames.csv")),
         report_json(staged.create("report.json")),
-        file_names(staged.create_scratch("report.json", "files")),
-        frame_records(staged.create_scratch("report.json", "frames")) {}
+        file_names(staged.create_scratch("report.json", "files")) {}
 
   StagedFiles staged;
   StagedFile& pairs_csv;
   StagedFile& frames_csv;
-  StagedFile& report_json;    ///< written by finish() only
-  StagedFile& file_names;     ///< inputs.files elements, one per frame added
-  StagedFile& frame_records;  ///< frames elements, one per frame added
+  StagedFile& report_json;  ///< its head, then frames elements as frames are added (the run's
+                            ///< bulk, never copied again), the rest by finish()
+  StagedFile& file_names;   ///< inputs.files elements, one per frame added
 };
 
 ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings,
@@ -65,6 +64,7 @@ ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version
   files_ = std::make_unique<Files>(*dir);
   files_->pairs_csv.out() << pairs_csv_header_for(objects_) << '\n';
   files_->frames_csv.out() << frames_csv_header_for(objects_) << '\n';
+  write_report_json_head(files_->report_json.out(), run_);
   writer_ = std::thread([this] { write_loop(); });
 }
 
@@ -103,9 +103,9 @@ void ReportStream::write_frame(const FrameRecord& frame, bool first) {
   write_pairs_rows(files_->pairs_csv.out(), frame, objects_);
   write_frames_row(files_->frames_csv.out(), frame, objects_);
   files_->file_names.out() << json_file_element(frame.file, first);
-  files_->frame_records.out() << json_frame_element(frame, first, objects_);
+  files_->report_json.out() << json_frame_element(frame, first, objects_);
   for (const StagedFile* f :
-       {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->frame_records})
+       {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->report_json})
     f->check();
 }
 
@@ -161,13 +161,10 @@ Summary ReportStream::finish(const Inputs& inputs, int builds, int rebuilds, dou
   const Summary summary = accumulator_.summary();
   if (files_) {
     if (const std::exception_ptr error = stop_writer()) std::rethrow_exception(error);
-    // The spools are closed (flushed, checked) before they are read back.
+    // The spool is closed (flushed, checked) before it is read back.
     files_->file_names.close();
-    files_->frame_records.close();
-    write_report_json(
-        files_->report_json.out(), run_, summary,
-        [&](std::ostream& out) { append_scratch(files_->file_names, out); },
-        [&](std::ostream& out) { append_scratch(files_->frame_records, out); });
+    write_report_json_tail(files_->report_json.out(), run_, summary,
+                           [&](std::ostream& out) { append_scratch(files_->file_names, out); });
     files_->staged.commit();
     files_.reset();
   }
