@@ -147,10 +147,9 @@ class ObjParser {
              "; expected 3 numbers (x y z)");
       }
       const char* start = p_;
-      // fast_float follows std::from_chars and rejects a leading '+', which some writers emit.
-      const char* first = (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-') ? p_ + 1 : p_;
+      const char* first = detail::past_plus(p_, end_);
       auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[k]);
-      if (ec != std::errc() || ptr == first || (ptr < end_ && !is_blank_or_eol(*ptr))) {
+      if (ec != std::errc() || ptr == first || !detail::ends_token(ptr, end_)) {
         fail("expected a number for the vertex's " + std::string(1, "xyz"[k]) +
              " coordinate, found " + quote_token(start, end_));
       }
@@ -171,7 +170,7 @@ class ObjParser {
       skip_blanks();
       if (at_eol() || *p_ == '#') break;  // '#' starts a trailing comment
       const char* start = p_;
-      const char* first = (*p_ == '+' && p_ + 1 < end_ && p_[1] != '-') ? p_ + 1 : p_;
+      const char* first = detail::past_plus(p_, end_);
       int64_t index = 0;
       auto [ptr, ec] = detail::parse_integer(first, end_, index);
       if (ec == std::errc::result_out_of_range) {

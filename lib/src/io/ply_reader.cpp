@@ -674,15 +674,11 @@ class AsciiBody {
     return start;
   }
 
-  /// Whether a number parsed up to `ptr` is the whole token: the parse and the token end
-  /// together, so that each character is read once.
-  bool ends_token(const char* ptr) const { return ptr == end_ || is_blank_or_eol(*ptr); }
-
   int64_t next_integer(const Element& el, int64_t i, const Property& prop, const char* what) {
     const char* start = skip_to_token(el, i);
     int64_t v = 0;
     auto [ptr, ec] = detail::parse_integer(start, end_, v);
-    if (ec != std::errc() || !ends_token(ptr)) {
+    if (ec != std::errc() || !detail::ends_token(ptr, end_)) {
       fail(std::string("expected an integer ") + what + " for " + quote(prop.name) + " of " +
            record_name(el, i) + ", found " + quote_token(start, end_));
     }
@@ -715,11 +711,11 @@ class AsciiBody {
         continue;
       }
       const char* start = skip_to_token(el, i);
-      // fast_float follows std::from_chars and rejects a leading '+', which some writers emit.
-      const char* first =
-          (*start == '+' && start + 1 < end_ && start[1] != '-') ? start + 1 : start;
+      // The number is parsed straight from the text and must end its token, so that each
+      // character is read once.
+      const char* first = detail::past_plus(start, end_);
       auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[axis]);
-      if (ec != std::errc() || ptr == first || !ends_token(ptr)) {
+      if (ec != std::errc() || ptr == first || !detail::ends_token(ptr, end_)) {
         fail(std::string("expected a number for the ") + "xyz"[axis] + " coordinate of " +
              record_name(el, i) + ", found " + quote_token(start, end_));
       }

@@ -25,6 +25,18 @@ inline const char* find_eol(const char* p, const char* end) {
   return nl ? static_cast<const char*>(nl) : end;
 }
 
+/// Where a number's parse starts in the token at `p`: past a leading '+' (which some writers
+/// emit, and which std::from_chars and fast_float reject), unless a sign follows it.
+inline const char* past_plus(const char* p, const char* end) {
+  return (*p == '+' && p + 1 < end && p[1] != '-') ? p + 1 : p;
+}
+
+/// Whether a number parsed up to `ptr` is its whole token: what follows it is a blank, a line
+/// end or the end of the text.
+inline bool ends_token(const char* ptr, const char* end) {
+  return ptr == end || is_blank_or_eol(*ptr);
+}
+
 /// std::from_chars for an integer (an index, a count), with a plain digit loop for the usual
 /// case of at most 18 digits (no overflow possible), which is about twice as fast.
 inline std::from_chars_result parse_integer(const char* first, const char* end, int64_t& value) {
