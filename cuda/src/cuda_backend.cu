@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cstring>
 #include <cub/device/device_radix_sort.cuh>
 
@@ -135,7 +136,7 @@ class CudaBackendImpl final : public CudaBackend {
     while (check_timers_.size() < topology.checks.size())
       check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
-                           initial_capacity_, initial_capacity_);
+                           initial_capacity_, initial_capacity_, initial_capacity_);
     stream_->synchronize();
   }
 
@@ -448,8 +449,9 @@ class CudaBackendImpl final : public CudaBackend {
   /// Result buffers for at least these counts. Never shrinks, so a sequence allocates only
   /// while its counts grow; the pair set's table is a power of two at least twice the pairs.
   void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates,
-                              uint64_t pairs, uint64_t listed) {
+                              uint64_t pairs, uint64_t listed, uint64_t subwalks) {
     listed_.reserve(listed);
+    subwalks_.reserve(subwalks);
     hits_.reserve(hits);
     uncertain_.reserve(uncertain);
     duplicates_.reserve(duplicates);
@@ -535,7 +537,9 @@ class CudaBackendImpl final : public CudaBackend {
   uint64_t builds_ = 0;
   unsigned max_blocks_ = 1;
   EventTimer detect_timer_;
-  DeviceBuffer<uint64_t> listed_;  // a check's candidate pairs, from its walk to its tests
+  DeviceBuffer<uint64_t> listed_;    // a check's candidate pairs, from its walks to its tests
+  DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
+                                     // above it to the subwalk kernel
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
@@ -616,6 +620,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
               pair_keys_.capacity()};
   const CandidateList listed{listed_.data(), listed_.capacity()};
+  const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity()};
   HostResults out = host_results_;
   out.limit = finish_limit_;
   SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
@@ -625,18 +630,22 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   for (size_t i = 0; i < checks.size(); ++i) {
     const detect::PartCheck check = topology_->checks[checks[i]];
     if (time_each) check_timers_[i]->start(s);
-    // Each check lists its candidates from the start of the list.
-    SNAG_CUDA_CHECK(cudaMemsetAsync(&counters_.data()->listed, 0, sizeof(unsigned long long), s));
+    // Each check lists its subwalks and candidates from the start of their lists.
+    static_assert(offsetof(FrameCounters, subwalks) ==
+                  offsetof(FrameCounters, listed) + sizeof(unsigned long long));
+    SNAG_CUDA_CHECK(
+        cudaMemsetAsync(&counters_.data()->listed, 0, 2 * sizeof(unsigned long long), s));
     if (check.self()) {
       if (part_size(check.a) > 0)
-        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, listed, results,
-                          use, max_blocks_, s);
+        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, subwalks, listed,
+                          results, use, max_blocks_, s);
     } else {
       // One thread per leaf of the larger part, walking the smaller one's tree.
       const bool a_larger = part_size(check.a) >= part_size(check.b);
       const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
       launch_cross_check(trees_[big]->view(), part_begin(big), trees_[small]->view(),
-                         part_begin(small), inputs, listed, results, use, max_blocks_, s);
+                         part_begin(small), inputs, subwalks, listed, results, use, max_blocks_,
+                         s);
     }
     if (time_each) check_timers_[i]->stop_async(s);
   }
@@ -699,11 +708,14 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     c = *counters_host_.data();
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
-        c.listed_most <= listed_.capacity())
+        c.listed_most <= listed_.capacity() && c.subwalks_most <= subwalks_.capacity())
       break;
-    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits.
+    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits. A
+    // subwalk list that overflowed left pairs unlisted (the candidate list may need a third
+    // run to grow to its full count).
     ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
-                           grown(c.expanded + c.duplicates), grown(c.listed_most));
+                           grown(c.expanded + c.duplicates), grown(c.listed_most),
+                           grown(c.subwalks_most));
     queue_detect(use, checks, owned);
   }
   collect_times();
@@ -801,15 +813,16 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     // rarely run a frame twice. Only now: growing discards the buffers' contents.
     const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain),
                    duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates),
-                   listed = grown(c.listed_most);
+                   listed = grown(c.listed_most), subwalks = grown(c.subwalks_most);
     if (hits > hits_.capacity() || uncertain > uncertain_.capacity() ||
         duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity() ||
-        listed > listed_.capacity())
+        listed > listed_.capacity() || subwalks > subwalks_.capacity())
       ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()),
                              std::max<uint64_t>(uncertain, uncertain_.capacity()),
                              std::max<uint64_t>(duplicates, duplicates_.capacity()),
                              std::max<uint64_t>(pairs, pair_keys_.capacity()),
-                             std::max<uint64_t>(listed, listed_.capacity()));
+                             std::max<uint64_t>(listed, listed_.capacity()),
+                             std::max<uint64_t>(subwalks, subwalks_.capacity()));
   }
   return frame;
 }

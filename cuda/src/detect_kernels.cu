@@ -90,8 +90,8 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
-/// A walk's listing: its thread's pairs held in a small local array and appended to the list
-/// a chunk at a time. Appending each pair on its own serialised the walks on the list's counter.
+/// A walk's listing (of candidate pairs, or of subwalks): its thread's keys held in a small
+/// local array and appended to the list a chunk at a time. Appending each pair on its own serialised the walks on the list's counter.
 /// A full chunk, met inside the walk's divergent loop, is appended by its thread alone (one
 /// atomic per 16 pairs: few walks list that many). The rest is appended once the walk is over
 /// (finish), by every thread at that one call site together: one atomic per group of converged
@@ -103,8 +103,8 @@ class PairLister {
  public:
   static constexpr int kChunk = 16;
 
-  __device__ PairLister(const CandidateList& list, unsigned long long* counter)
-      : list_(list), counter_(counter) {}
+  __device__ PairLister(uint64_t* keys, unsigned long long capacity, unsigned long long* counter)
+      : keys_(keys), capacity_(capacity), counter_(counter) {}
 
   __device__ __forceinline__ void add(uint64_t pair) {
     held_[count_++] = pair;
@@ -130,44 +130,71 @@ class PairLister {
  private:
   __device__ __forceinline__ void store(unsigned long long base) {
     for (int k = 0; k < count_; ++k)
-      if (base + k < list_.capacity) list_.pairs[base + k] = held_[k];
+      if (base + k < capacity_) keys_[base + k] = held_[k];
   }
 
-  const CandidateList& list_;
+  uint64_t* keys_;
+  unsigned long long capacity_;
   unsigned long long* counter_;
   uint64_t held_[kChunk];
   int count_ = 0;
 };
 
-/// A part's walk: the leaf at `position` (so that a warp's triangles are neighbours and follow
-/// nearly the same path) against the later leaves, listing (t, leaf node) for every overlap.
-/// Nothing is loaded at a leaf: degenerate triangles and shared corners are the pair tests'
-/// business, so the walk is box tests only. The pairs of the neighbour list (triangles that
-/// share a vertex, whose boxes always overlap) are among the listed ones, each once.
+/// A part's walks above the split level: the leaf at `position` (so that a warp's triangles
+/// are neighbours and follow nearly the same path) against the later leaves, handing over
+/// (position, node) for every overlapping node at `first_unopened` or after (the split level
+/// and under it; see SubwalkList). Nothing is loaded at a node handed over: degenerate
+/// triangles and shared corners are the pair tests' business, so the walks are box tests only.
 __global__ void __launch_bounds__(kNarrowBlock)
-    self_walk_kernel(bvh::TreeView tree, int32_t base, const uint8_t* degenerate,
-                     CandidateList listed, FrameCounters* counters) {
+    self_walk_kernel(bvh::TreeView tree, int32_t base, int32_t first_unopened,
+                     const uint8_t* degenerate, SubwalkList subwalks, FrameCounters* counters) {
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
-  const int32_t t = base + tree.triangle_at[position];
-  if (degenerate[t]) return;
-  PairLister lister(listed, &counters->listed);
-  bvh::for_each_later_overlapping_leaf(tree, position,
-                                       [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+  if (degenerate[base + tree.triangle_at[position]]) return;
+  PairLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
+  bvh::for_each_later_overlapping_leaf(
+      tree, position, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
   lister.finish();
 }
 
-/// Two parts' walk: the leaf at `position` of `tree` (part a) against every leaf of `other`.
+/// Two parts' walks above the split level of `other`: the leaf at `position` of `tree` (part
+/// a) against every leaf of `other`, as self_walk_kernel hands its nodes over.
 __global__ void __launch_bounds__(kNarrowBlock)
     cross_walk_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other,
-                      const uint8_t* degenerate, CandidateList listed, FrameCounters* counters) {
+                      int32_t first_unopened, const uint8_t* degenerate, SubwalkList subwalks,
+                      FrameCounters* counters) {
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
-  const int32_t t = base_a + tree.triangle_at[position];
-  if (degenerate[t]) return;
-  PairLister lister(listed, &counters->listed);
+  if (degenerate[base_a + tree.triangle_at[position]]) return;
+  PairLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
   const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-  bvh::for_each_overlapping_leaf(other, box, [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+  bvh::for_each_overlapping_leaf(
+      other, box, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
+  lister.finish();
+}
+
+/// The subwalks of one check, one per handed-over (position, node): the leaf at `position` of
+/// `tree` (its triangle plus `base` is t) against the leaves under `node` of `walked` (the
+/// same tree for a part against itself), listing (t, leaf) for every overlap. Queued before
+/// the walks' count is known: a fixed grid (launch_counted) strides over the subwalks.
+__global__ void __launch_bounds__(kBlock)
+    subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, SubwalkList subwalks,
+                   CandidateList listed, FrameCounters* counters) {
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
+  const unsigned long long count = counters->subwalks;
+  if (first == 0) atomicMax(&counters->subwalks_most, count);
+  const unsigned long long stored = min(count, subwalks.capacity);
+  PairLister lister(listed.pairs, listed.capacity, &counters->listed);
+  for (unsigned long long i = first; i < stored; i += stride) {
+    const uint64_t walk = subwalks.walks[i];
+    const auto position = static_cast<int32_t>(walk >> 32);
+    const auto node = static_cast<int32_t>(walk & 0xffffffffu);
+    const int32_t t = base + tree.triangle_at[position];
+    const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
+    bvh::for_each_overlapping_leaf_under(walked, node, box,
+                                         [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+  }
   lister.finish();
 }
 
@@ -401,25 +428,38 @@ unsigned walk_blocks(const bvh::TreeView& tree) {
 
 }  // namespace
 
+void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
+                     const SubwalkList& subwalks, const CandidateList& listed,
+                     const ResultBuffers& results, unsigned max_blocks, cudaStream_t stream) {
+  launch_counted(subwalk_kernel, subwalks.capacity, max_blocks, stream, tree, base, walked,
+                 subwalks, listed, results.counters);
+}
+
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const CandidateList& listed, const ResultBuffers& results,
-                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
+                       const SubwalkList& subwalks, const CandidateList& listed,
+                       const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
+                       cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
-  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(tree, base, inputs.degenerate,
-                                                                   listed, results.counters);
+  const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(tree.shape));
+  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
+      tree, base, first_unopened, inputs.degenerate, subwalks, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
+  launch_subwalks(tree, base, tree, subwalks, listed, results, max_blocks, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
 
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
-                        int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
-                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
-                        cudaStream_t stream) {
+                        int32_t base_b, const PairInputs& inputs, const SubwalkList& subwalks,
+                        const CandidateList& listed, const ResultBuffers& results,
+                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
+  const int32_t first_unopened =
+      bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
   cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
-      tree, base_a, other, inputs.degenerate, listed, results.counters);
+      tree, base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
+  launch_subwalks(tree, base_a, other, subwalks, listed, results, max_blocks, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
 

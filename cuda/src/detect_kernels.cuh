@@ -27,10 +27,13 @@ struct FrameCounters {
   unsigned long long degenerate;  ///< scan: certainly degenerate triangles
   unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
   unsigned long long pairs;  ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
-  unsigned long long listed;       ///< the current check's walk: candidate pairs it listed
-                                   ///< (zeroed before each check's walk)
-  unsigned long long listed_most;  ///< the most any check of the frame listed (entries wanted
-                                   ///< in the candidate list)
+  unsigned long long listed;    ///< the current check's walks: candidate pairs they listed
+  unsigned long long subwalks;  ///< the current check's walks above the split level: the
+                                ///< subwalks they handed over (zeroed with `listed` before
+                                ///< each check, the two side by side)
+  unsigned long long listed_most;    ///< the most any check of the frame listed (entries wanted
+                                     ///< in the candidate list)
+  unsigned long long subwalks_most;  ///< likewise for the subwalk list
 };
 
 /// Where a check's walk lists its candidate pairs for the pair tests: (t << 32 | leaf) keys, t
@@ -38,6 +41,16 @@ struct FrameCounters {
 /// `capacity` only counters->listed moves.
 struct CandidateList {
   uint64_t* pairs = nullptr;
+  unsigned long long capacity = 0;
+};
+
+/// Where a check's walks above the split level (bvh::split_walk_level) hand over the rest of
+/// their work: (position << 32 | node) keys, position the walking leaf's (in its tree), node
+/// an overlapping node of the tree walked, at the split level or under it, whose leaves are
+/// still to be searched (a leaf itself, or a subtree of at most 64). Past `capacity` only
+/// counters->subwalks moves.
+struct SubwalkList {
+  uint64_t* walks = nullptr;
   unsigned long long capacity = 0;
 };
 
@@ -110,29 +123,36 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream);
 
-/// A part against itself, in two launches. The walk: one thread per leaf position of its tree
-/// (in leaf order; the tree's triangle ids plus `base` are the topology's), listing every later
-/// overlapping leaf into `listed`, counted in results.counters->listed (which the caller zeroes
-/// first). The pair tests: one per listed pair, through detect::test_candidate_pair
-/// (shared corners from the ids; degenerate triangles left out). The listed pairs are the CPU's
-/// neighbour pairs and traversal candidates together, each once: triangles that share a vertex
-/// always have overlapping boxes. Listing first keeps the walk to box tests (a walk that tested
-/// its pairs, or loaded anything at its leaves, held its warp's other walks back each time),
-/// and spreads the tests of a folded region's leaves over the whole device. With
+/// A part against itself, in three launches. The walks, split at bvh::split_walk_level: one
+/// thread per leaf position of its tree (in leaf order; the tree's triangle ids plus `base`
+/// are the topology's) walks the later leaves' subtrees down to that level, handing every
+/// overlapping node there to `subwalks`; then one thread per subwalk walks that node's
+/// subtree, listing every overlapping leaf into `listed`, counted in
+/// results.counters->listed (which the caller zeroes first, with ->subwalks). The longest walk
+/// of a folded region's leaf (267 box tests at 36K) was the walk kernel's time, at two warps
+/// per scheduler: split, it is two chains of at most ~60, the second over three times as
+/// many threads. The pair tests: one per listed pair, through detect::test_candidate_pair
+/// (shared corners from the ids; degenerate triangles left out). The listed pairs are the
+/// CPU's neighbour pairs and traversal candidates together, each once: triangles that share
+/// a vertex always have overlapping boxes. Listing first keeps the walk to box tests (a walk
+/// that tested its pairs, or loaded anything at its leaves, held its warp's other walks back
+/// each time), and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
-/// its own, so that the usual one carries no branch for it. The pair tests run on at most
-/// `max_blocks` blocks (striding over the list when it is longer).
+/// its own, so that the usual one carries no branch for it. The subwalks and the pair tests
+/// run on at most `max_blocks` blocks (striding over their lists when longer).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const CandidateList& listed, const ResultBuffers& results,
-                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream);
+                       const SubwalkList& subwalks, const CandidateList& listed,
+                       const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
+                       cudaStream_t stream);
 
 /// Two parts, the same way: one thread per leaf of `tree` (part a, whose first triangle is
-/// base_a) listing the overlapping leaves of all of `other` (part b), then the pair tests of
-/// the list (parts share no vertex: no shared corners).
+/// base_a) walking all of `other` (part b) down to its split level, the subwalks under the
+/// overlapping nodes there, then the pair tests of the list (parts share no vertex: no shared
+/// corners).
 void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::TreeView& other,
-                        int32_t base_b, const PairInputs& inputs, const CandidateList& listed,
-                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
-                        cudaStream_t stream);
+                        int32_t base_b, const PairInputs& inputs, const SubwalkList& subwalks,
+                        const CandidateList& listed, const ResultBuffers& results,
+                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream);
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with

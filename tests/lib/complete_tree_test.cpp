@@ -212,6 +212,73 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   }
 }
 
+/// Every pair of the per-leaf walk split at level `cut` (as the GPU runs it): the leaves the
+/// walks above the cut visit, and those under each internal node they hand over.
+PairMultiset split_walk_pairs(const TreeView& view, int32_t cut, int64_t& handed_over) {
+  PairMultiset pairs;
+  const int32_t first_unopened = CompleteTree::level_begin(cut);
+  for (int32_t p = 0; p < view.shape.leaf_count; ++p) {
+    const int32_t t = view.triangle_at[p];
+    const geom::Box3f box = view.boxes[view.shape.leaf_at(p)];
+    auto add = [&](int32_t leaf) {
+      EXPECT_TRUE(view.shape.is_leaf(leaf));
+      const int32_t x = view.triangle_at[view.shape.position_of(leaf)];
+      pairs.insert({std::min(t, x), std::max(t, x)});
+    };
+    for_each_later_overlapping_leaf(
+        view, p,
+        [&](int32_t node) {
+          EXPECT_TRUE(view.shape.is_leaf(node) || node >= first_unopened);
+          if (view.shape.is_leaf(node)) return add(node);
+          ++handed_over;
+          for_each_overlapping_leaf_under(view, node, box, add);
+        },
+        first_unopened);
+  }
+  return pairs;
+}
+
+TEST(Traversal, WalksSplitAtAnyLevelVisitTheSamePairsOnce) {
+  for (int32_t n : {1, 2, 3, 9, 50, 513, 2000}) {
+    for (double size : {0.2, 1.0, 4.0}) {
+      Soup soup = random_soup(n, static_cast<uint32_t>(n * 17 + size * 3), size);
+      Tree tree;
+      tree.build(soup.view(), 2);
+      const TreeView view = tree.view();
+      const PairMultiset expected = per_leaf_pairs(view);
+      for (int32_t cut = 0; cut <= view.shape.depth; ++cut) {
+        SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
+                     " cut=" + std::to_string(cut));
+        int64_t handed_over = 0;
+        ASSERT_EQ(split_walk_pairs(view, cut, handed_over), expected);
+        // At the leaves' deepest level nothing internal is left to hand over; at the GPU's
+        // level, in a soup of large triangles, the split is real.
+        if (cut >= view.shape.depth) EXPECT_EQ(handed_over, 0);
+        if (n >= 513 && size >= 1.0 && cut == split_walk_level(view.shape))
+          EXPECT_GT(handed_over, 0);
+      }
+      if (n == 2000) EXPECT_EQ(split_walk_level(view.shape), view.shape.depth - 6);
+      // A query from another tree's leaf (two parts checked against each other), split alike.
+      for (int32_t query = 0; query < std::min<int32_t>(n, 40); ++query) {
+        const geom::Box3f box = view.boxes[view.shape.leaf_at(query)];
+        std::multiset<int32_t> expected_leaves;
+        for_each_overlapping_leaf(view, box, [&](int32_t leaf) { expected_leaves.insert(leaf); });
+        for (int32_t cut = 0; cut <= view.shape.depth; ++cut) {
+          std::multiset<int32_t> leaves;
+          for_each_overlapping_leaf(
+              view, box,
+              [&](int32_t node) {
+                for_each_overlapping_leaf_under(view, node, box,
+                                                [&](int32_t leaf) { leaves.insert(leaf); });
+              },
+              CompleteTree::level_begin(cut));
+          ASSERT_EQ(leaves, expected_leaves) << "n=" << n << " query=" << query << " cut=" << cut;
+        }
+      }
+    }
+  }
+}
+
 TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
   // Random boxes searched under random roots: the same leaves in the same order, and the same
   // nodes tested.

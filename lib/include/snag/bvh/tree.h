@@ -87,10 +87,15 @@ SNAG_HD_INLINE void walk_subtree(const TreeView& tree, int32_t root, Test&& test
 /// possible successors' boxes are read before the current one is tested, so that the read
 /// leaves the step's chain of dependent instructions. On a GPU, where a walk is that chain and
 /// little else hides it, this took the 36K walk from 77 to 69 us. Same nodes, same order.
+///
+/// Nodes from index `first_unopened` on are not opened: one that overlaps goes to at_leaf as a
+/// leaf does (the default opens every internal node). Since a level's nodes are consecutive,
+/// level_begin(L) stops the walk at level L (split_walk_level).
 template <class Overlaps, class AtLeaf>
 SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root, Overlaps&& overlaps,
-                                            AtLeaf&& at_leaf) {
-  const int32_t first_leaf = tree.shape.leaf_count - 1;
+                                            AtLeaf&& at_leaf, int32_t first_unopened = INT32_MAX) {
+  const int32_t first_leaf =
+      tree.shape.leaf_count - 1 < first_unopened ? tree.shape.leaf_count - 1 : first_unopened;
   const int32_t below_root = level_end(root);
   int32_t i = root;
   geom::Box3f box = tree.boxes[root];
@@ -113,16 +118,39 @@ SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root, 
 /// from the earlier one. For every ancestor reached from a left child, the right sibling's
 /// subtree holds exactly the later leaves under that ancestor; each is walked
 /// (walk_subtree_read_ahead). Nothing but boxes is read.
+///
+/// With `first_unopened` (see walk_subtree_read_ahead), the walks stop there: visit(node) also
+/// gets each overlapping node they do not open, and the later overlapping leaves are then
+/// those visited plus, under each such internal node, those for_each_overlapping_leaf_under
+/// finds.
 template <class Visit>
-SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t position,
-                                                    Visit&& visit) {
+SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t position, Visit&& visit,
+                                                    int32_t first_unopened = INT32_MAX) {
   const int32_t leaf = tree.shape.leaf_at(position);
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
     walk_subtree_read_ahead(
-        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
+        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit,
+        first_unopened);
   }
+}
+
+/// Calls visit(leaf) with the node index of every leaf under `node` (itself, when it is one)
+/// whose box overlaps `box`.
+template <class Visit>
+SNAG_HD_INLINE void for_each_overlapping_leaf_under(TreeView tree, int32_t node,
+                                                    const geom::Box3f& box, Visit&& visit) {
+  walk_subtree_read_ahead(
+      tree, node, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
+}
+
+/// The level at which a GPU splits each leaf's walk in two (the walks above it, then one
+/// walk under each overlapping node of it): six levels above the deepest, so that the nodes
+/// split at hold 32 to 64 leaves. On a settled 36K cloth frame (depth 16), the longest walk
+/// of 267 box tests becomes at most 58 above the cut and 52 under one node.
+SNAG_HD_INLINE int32_t split_walk_level(const CompleteTree& shape) {
+  return shape.depth > 6 ? shape.depth - 6 : 0;
 }
 
 /// for_each_later_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
@@ -134,11 +162,14 @@ SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visi
 
 /// Calls visit(leaf) with the node index of every leaf of `tree` whose box overlaps `box`: a
 /// query from another tree's leaf (two objects checked against each other).
+/// With `first_unopened`, visit also gets the overlapping nodes not opened, as in
+/// for_each_later_overlapping_leaf.
 template <class Visit>
 SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box,
-                                              Visit&& visit) {
+                                              Visit&& visit, int32_t first_unopened = INT32_MAX) {
   walk_subtree_read_ahead(
-      tree, 0, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
+      tree, 0, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit,
+      first_unopened);
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
@@ -224,10 +255,16 @@ struct LeafLanes {
            (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) & present;
   }
 
+  /// Bit `lane` of the result set for each lane whose bit is set in `mask`.
+  static uint32_t bits(Mask mask) {
+    return static_cast<uint32_t>((mask[0] & 1) | (mask[1] & 2) | (mask[2] & 4) | (mask[3] & 8));
+  }
+
   /// Walks `tree`'s subtree under `root` for all lanes at once, descending where any lane
-  /// overlaps; at a leaf, calls visit(lane triangle, leaf's triangle) for each overlapping lane.
-  template <class Visit>
-  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
+  /// overlaps; at a leaf, calls visit_leaf(lane_bits, leaf's triangle) with a bit per lane
+  /// that overlaps it (at least one).
+  template <class VisitLeaf>
+  void walk_leaves(const TreeView& tree, int32_t root, VisitLeaf&& visit_leaf) const {
     Mask last{};
     walk_subtree(
         tree, root,
@@ -235,11 +272,31 @@ struct LeafLanes {
           last = overlaps(tree.boxes[i]);
           return (last[0] | last[1] | last[2] | last[3]) != 0;
         },
-        [&](int32_t i) {
-          const int32_t other = tree.triangle_at[tree.shape.position_of(i)];
-          for (int lane = 0; lane < 4; ++lane)
-            if (last[lane]) visit(triangle[lane], other);
-        });
+        [&](int32_t i) { visit_leaf(bits(last), tree.triangle_at[tree.shape.position_of(i)]); });
+  }
+
+  /// walk_leaves, calling visit(lane triangle, leaf's triangle) for each overlapping lane.
+  template <class Visit>
+  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
+    walk_leaves(tree, root, [&](uint32_t lanes, int32_t other) {
+      for (; lanes; lanes &= lanes - 1) visit(triangle[count_trailing_zeros(lanes)], other);
+    });
+  }
+
+  /// The query of for_each_later_overlap for every member at once (this group's node is
+  /// `group`): calls visit_leaf(lane_bits, other_triangle) for every later leaf, with a bit for
+  /// each member whose box overlaps it, so that each unordered pair is visited once. Pairs of
+  /// members come first, as (bit of the earlier member, later member's triangle).
+  template <class VisitLeaf>
+  void for_each_later(const TreeView& tree, int32_t group, VisitLeaf&& visit_leaf) const {
+    for (int a = 0; a < members; ++a)
+      for (int b = a + 1; b < members; ++b)
+        if (geom::overlap(tree.boxes[leaf[a]], tree.boxes[leaf[b]]))
+          visit_leaf(1u << a, triangle[b]);
+    // Members against the later subtrees: the right siblings of the group's left-child
+    // ancestors.
+    for (int32_t node = group; node > 0; node = (node - 1) >> 1)
+      if (node & 1) walk_leaves(tree, node + 1, visit_leaf);
   }
 };
 
@@ -247,18 +304,13 @@ struct LeafLanes {
 /// `group` of group_level() at once: calls visit(member_triangle, other_triangle) for every
 /// pair of a member and a later leaf whose boxes overlap, each unordered pair once. The
 /// members share every ancestor above the group, so their walks through the later subtrees
-/// are one walk (LeafLanes::walk). Pairs of members are tested directly. Used by the CPU
-/// backend; memory: a few registers and the four boxes.
+/// are one walk (LeafLanes::for_each_later). Memory: a few registers and the four boxes.
 template <class Visit>
 inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
   const LeafLanes lanes(tree, group);
-  for (int a = 0; a < lanes.members; ++a)
-    for (int b = a + 1; b < lanes.members; ++b)
-      if (geom::overlap(tree.boxes[lanes.leaf[a]], tree.boxes[lanes.leaf[b]]))
-        visit(lanes.triangle[a], lanes.triangle[b]);
-  // Members against the later subtrees: the right siblings of the group's left-child ancestors.
-  for (int32_t node = group; node > 0; node = (node - 1) >> 1)
-    if (node & 1) lanes.walk(tree, node + 1, visit);
+  lanes.for_each_later(tree, group, [&](uint32_t bits, int32_t other) {
+    for (; bits; bits &= bits - 1) visit(lanes.triangle[count_trailing_zeros(bits)], other);
+  });
 }
 
 /// for_each_overlap for the (up to four) leaves under node `group` of `tree` (group_level())
