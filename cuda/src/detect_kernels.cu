@@ -431,8 +431,11 @@ unsigned walk_blocks(const bvh::TreeView& tree) {
 void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
                      const SubwalkList& subwalks, const CandidateList& listed,
                      const ResultBuffers& results, unsigned max_blocks, cudaStream_t stream) {
-  launch_counted(subwalk_kernel, subwalks.capacity, max_blocks, stream, tree, base, walked,
-                 subwalks, listed, results.counters);
+  // A grid over the whole capacity, one thread per subwalk: capped at max_blocks, each thread
+  // ran its share of a large frame's subwalks one after another (ten each at 1M triangles:
+  // traverse 1.0 -> 1.8 ms); uncapped, 1.09 ms. Threads past the count return at once.
+  launch_counted(subwalk_kernel, subwalks.capacity, ~0u, stream, tree, base, walked, subwalks,
+                 listed, results.counters);
 }
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,

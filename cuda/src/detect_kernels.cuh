@@ -138,8 +138,8 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// that tested its pairs, or loaded anything at its leaves, held its warp's other walks back
 /// each time), and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
-/// its own, so that the usual one carries no branch for it. The subwalks and the pair tests
-/// run on at most `max_blocks` blocks (striding over their lists when longer).
+/// its own, so that the usual one carries no branch for it. The subwalks run one per thread;
+/// the pair tests on at most `max_blocks` blocks (striding over the list when longer).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const SubwalkList& subwalks, const CandidateList& listed,
                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
