@@ -137,6 +137,7 @@ class CudaBackendImpl final : public CudaBackend {
       check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
                            initial_capacity_, initial_capacity_, initial_capacity_);
+    subwalks_expected_ = static_cast<uint64_t>(initial_capacity_);
     stream_->synchronize();
   }
 
@@ -540,6 +541,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint64_t> listed_;    // a check's candidate pairs, from its walks to its tests
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
+  uint64_t subwalks_expected_ = 1;     // the last frame's most subwalks, with slack
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
@@ -620,7 +622,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
               pair_keys_.capacity()};
   const CandidateList listed{listed_.data(), listed_.capacity()};
-  const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity()};
+  const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
   HostResults out = host_results_;
   out.limit = finish_limit_;
   SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
@@ -710,12 +712,14 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
         c.listed_most <= listed_.capacity() && c.subwalks_most <= subwalks_.capacity())
       break;
-    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits. A
-    // subwalk list that overflowed left pairs unlisted (the candidate list may need a third
-    // run to grow to its full count).
+    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits, but
+    // for the stages after one that overflowed: a subwalk list that overflowed left pairs
+    // unlisted, a candidate list that overflowed left hits unfound, so each undercounts the
+    // stages after it, and a frame can take up to four runs. None is ever lost.
     ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
                            grown(c.expanded + c.duplicates), grown(c.listed_most),
                            grown(c.subwalks_most));
+    subwalks_expected_ = grown(c.subwalks_most);
     queue_detect(use, checks, owned);
   }
   collect_times();
@@ -814,6 +818,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain),
                    duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates),
                    listed = grown(c.listed_most), subwalks = grown(c.subwalks_most);
+    subwalks_expected_ = subwalks;
     if (hits > hits_.capacity() || uncertain > uncertain_.capacity() ||
         duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity() ||
         listed > listed_.capacity() || subwalks > subwalks_.capacity())

@@ -91,23 +91,23 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
 }
 
 /// A walk's listing (of candidate pairs, or of subwalks): its thread's keys held in a small
-/// local array and appended to the list a chunk at a time. Appending each pair on its own serialised the walks on the list's counter.
-/// A full chunk, met inside the walk's divergent loop, is appended by its thread alone (one
-/// atomic per 16 pairs: few walks list that many). The rest is appended once the walk is over
+/// local array and appended to the list a chunk at a time. Appending each key on its own
+/// serialised the walks on the list's counter. A full chunk, met inside the walk's divergent
+/// loop, is appended by its thread alone (one atomic per 16 keys: few walks list that many). The rest is appended once the walk is over
 /// (finish), by every thread at that one call site together: one atomic per group of converged
 /// threads. A group append inside the loop once counted pairs it never wrote: with boxes padded
 /// to 32 bytes (tried, and slower), the recompiled walk listed unwritten (zero) entries, caught
 /// by the tests and by memcheck in the pair tests. Not fully explained; a thread appending
 /// alone cannot be mistaken about which threads take part.
-class PairLister {
+class KeyLister {
  public:
   static constexpr int kChunk = 16;
 
-  __device__ PairLister(uint64_t* keys, unsigned long long capacity, unsigned long long* counter)
+  __device__ KeyLister(uint64_t* keys, unsigned long long capacity, unsigned long long* counter)
       : keys_(keys), capacity_(capacity), counter_(counter) {}
 
-  __device__ __forceinline__ void add(uint64_t pair) {
-    held_[count_++] = pair;
+  __device__ __forceinline__ void add(uint64_t key) {
+    held_[count_++] = key;
     if (count_ == kChunk) {
       store(atomicAdd(counter_, static_cast<unsigned long long>(kChunk)));
       count_ = 0;
@@ -151,7 +151,7 @@ __global__ void __launch_bounds__(kNarrowBlock)
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   if (degenerate[base + tree.triangle_at[position]]) return;
-  PairLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
+  KeyLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
   bvh::for_each_later_overlapping_leaf(
       tree, position, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
   lister.finish();
@@ -166,7 +166,7 @@ __global__ void __launch_bounds__(kNarrowBlock)
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   if (degenerate[base_a + tree.triangle_at[position]]) return;
-  PairLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
+  KeyLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
   const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
   bvh::for_each_overlapping_leaf(
       other, box, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
@@ -176,7 +176,8 @@ __global__ void __launch_bounds__(kNarrowBlock)
 /// The subwalks of one check, one per handed-over (position, node): the leaf at `position` of
 /// `tree` (its triangle plus `base` is t) against the leaves under `node` of `walked` (the
 /// same tree for a part against itself), listing (t, leaf) for every overlap. Queued before
-/// the walks' count is known: a fixed grid (launch_counted) strides over the subwalks.
+/// the walks' count is known, on a grid for the count expected (SubwalkList::expected): one
+/// subwalk per thread, striding past that when there are more.
 __global__ void __launch_bounds__(kBlock)
     subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, SubwalkList subwalks,
                    CandidateList listed, FrameCounters* counters) {
@@ -185,7 +186,7 @@ __global__ void __launch_bounds__(kBlock)
   const unsigned long long count = counters->subwalks;
   if (first == 0) atomicMax(&counters->subwalks_most, count);
   const unsigned long long stored = min(count, subwalks.capacity);
-  PairLister lister(listed.pairs, listed.capacity, &counters->listed);
+  KeyLister lister(listed.pairs, listed.capacity, &counters->listed);
   for (unsigned long long i = first; i < stored; i += stride) {
     const uint64_t walk = subwalks.walks[i];
     const auto position = static_cast<int32_t>(walk >> 32);
@@ -398,8 +399,8 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 namespace {
 
 /// A launch whose item count is known only on the device, when it runs: a grid that covers
-/// `bound` items (a buffer's capacity) but no more than `max_blocks`, the kernel striding over
-/// the items the device counted. Capacities only grow: after one heavily folded frame, a grid
+/// `bound` items (a buffer's capacity, or a count expected) but no more than `max_blocks`, the
+/// kernel striding over the items the device counted. Capacities only grow: after one heavily folded frame, a grid
 /// sized by them would launch mostly idle blocks for every later one.
 template <class... Params, class... Args>
 void launch_counted(void (*kernel)(Params...), unsigned long long bound, unsigned max_blocks,
@@ -422,21 +423,23 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
                    stream, inputs, walked, walked_base, listed, results);
 }
 
+/// A grid for the subwalks expected, one per thread. Capped at max_blocks (as the pair tests
+/// are), each thread ran its share of a large frame's subwalks one after another (ten each at
+/// 1M triangles: traverse 1.0 -> 1.8 ms); one per thread, 1.09 ms. Sized by the expected count
+/// rather than the capacity, which only grows: a heavy frame does not leave every later check
+/// launching thousands of idle blocks.
+void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
+                     const SubwalkList& subwalks, const CandidateList& listed,
+                     const ResultBuffers& results, cudaStream_t stream) {
+  launch_counted(subwalk_kernel, std::min(subwalks.expected, subwalks.capacity), ~0u, stream,
+                 tree, base, walked, subwalks, listed, results.counters);
+}
+
 unsigned walk_blocks(const bvh::TreeView& tree) {
   return static_cast<unsigned>((tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock);
 }
 
 }  // namespace
-
-void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
-                     const SubwalkList& subwalks, const CandidateList& listed,
-                     const ResultBuffers& results, unsigned max_blocks, cudaStream_t stream) {
-  // A grid over the whole capacity, one thread per subwalk: capped at max_blocks, each thread
-  // ran its share of a large frame's subwalks one after another (ten each at 1M triangles:
-  // traverse 1.0 -> 1.8 ms); uncapped, 1.09 ms. Threads past the count return at once.
-  launch_counted(subwalk_kernel, subwalks.capacity, ~0u, stream, tree, base, walked, subwalks,
-                 listed, results.counters);
-}
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const SubwalkList& subwalks, const CandidateList& listed,
@@ -448,7 +451,7 @@ void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs
   self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
       tree, base, first_unopened, inputs.degenerate, subwalks, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_subwalks(tree, base, tree, subwalks, listed, results, max_blocks, stream);
+  launch_subwalks(tree, base, tree, subwalks, listed, results, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
 
@@ -462,7 +465,7 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
   cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
       tree, base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();
-  launch_subwalks(tree, base_a, other, subwalks, listed, results, max_blocks, stream);
+  launch_subwalks(tree, base_a, other, subwalks, listed, results, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
 

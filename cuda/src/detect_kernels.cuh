@@ -52,6 +52,7 @@ struct CandidateList {
 struct SubwalkList {
   uint64_t* walks = nullptr;
   unsigned long long capacity = 0;
+  unsigned long long expected = 0;  ///< what the subwalk kernel's grid is sized for
 };
 
 /// The pairs of a frame as the expansion leaves them: distinct (a << bits | b) keys, a < b, in

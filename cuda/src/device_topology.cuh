@@ -1,6 +1,6 @@
 // The per-topology arrays on the device, uploaded once by set_topology: what the pair tests
 // and the expansion of hits into face pairs read. The neighbour list of the CPU backend is not
-// among them: the GPU's walk lists neighbouring triangles with the rest (launch_self_check).
+// among them: the GPU's subwalks list neighbouring triangles with the rest (launch_self_check).
 //
 // Memory: triangles 12 B, triangle edges 12 B, ownership 2 x 1 B and degenerate flags 1 B per
 // triangle; edges 8 B and edge-face offsets 4 B per edge, 4 B per edge-face incidence.

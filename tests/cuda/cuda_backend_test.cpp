@@ -451,7 +451,8 @@ TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
 }
 
 /// A scene checked frame after frame on both backends; `capacity` > 0 starts the GPU's result
-/// buffers (its candidate list included) that small, so that checks overflow them and run again.
+/// buffers (its subwalk and candidate lists included) that small, so that checks overflow them
+/// and run again.
 void expect_scene_matches(int64_t capacity) {
   // A folded cloth, a lattice body and a second sheet, checked as a scene frame after frame:
   // the cloth moves every frame, the body never, the sheet in some; frames 6 and 7 are frozen.

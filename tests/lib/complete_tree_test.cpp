@@ -225,12 +225,13 @@ PairMultiset split_walk_pairs(const TreeView& view, int32_t cut, int64_t& handed
       const int32_t x = view.triangle_at[view.shape.position_of(leaf)];
       pairs.insert({std::min(t, x), std::max(t, x)});
     };
+    // As the GPU does: every node handed over, a leaf included, is searched by a walk of its
+    // own.
     for_each_later_overlapping_leaf(
         view, p,
         [&](int32_t node) {
           EXPECT_TRUE(view.shape.is_leaf(node) || node >= first_unopened);
-          if (view.shape.is_leaf(node)) return add(node);
-          ++handed_over;
+          if (!view.shape.is_leaf(node)) ++handed_over;
           for_each_overlapping_leaf_under(view, node, box, add);
         },
         first_unopened);

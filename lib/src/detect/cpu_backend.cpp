@@ -200,8 +200,9 @@ class CpuBackend final : public Backend {
   /// then the other candidates from its tree. The leaves of each group of up to four
   /// consecutive positions walk the tree together (LeafLanes::for_each_later), groups in leaf
   /// order; dynamic chunks because groups in dense regions cost more. At each leaf the walk
-  /// reaches, the lanes that share a listed vertex with it are dropped together before any
-  /// pair is looked at one by one.
+  /// reaches, the lanes that share a vertex with it are found together; when every vertex is
+  /// listed (no weld left some out) they are dropped at once, else lane by lane
+  /// (listed_among).
   template <FilterUse use>
   void detect_self(int32_t part, const FrameView& frame_view, const TopologyView& view,
                    const std::vector<uint8_t>& degenerate_flags, std::vector<ThreadSink>& sinks) {
@@ -227,17 +228,19 @@ class CpuBackend final : public Backend {
 #pragma omp for schedule(dynamic, 64)
       for (int32_t group = first_group; group < last_group; ++group) {
         const bvh::LeafLanes lanes(tree, group);
-        const LaneCorners corners(lanes, topo.triangles.data() + base);
+        const LaneCorners corners(lanes, view.triangles + base);
         lanes.for_each_later(tree, group, [&](uint32_t overlapping, int32_t local_x) {
           const int32_t x = base + local_x;
-          const geom::Tri xt = topo.triangles[x];
+          const geom::Tri xt = view.triangles[x];
           uint32_t sharing = corners.sharing(xt);
           // Most overlapping leaves are listed neighbours of every lane they overlap (94% of
           // the overlaps of a settled 36K cloth frame): they end here, after a few compares.
           if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, base, xt, view);
-          for (uint32_t todo = overlapping & ~sharing; todo; todo &= todo - 1) {
+          uint32_t todo = overlapping & ~sharing;
+          if (todo && degenerate_flags[x]) return;
+          for (; todo; todo &= todo - 1) {
             const int32_t t = base + lanes.triangle[bvh::count_trailing_zeros(todo)];
-            if (degenerate_flags[t] || degenerate_flags[x]) continue;
+            if (degenerate_flags[t]) continue;
             ++sink.candidates;
             test_candidate_pair<use>(frame_view, view, t, x, sink);
           }

@@ -48,8 +48,9 @@ class CudaBackend : public detect::Backend {
   /// Makes resident frame `index` the current positions (no copy).
   virtual void select_resident_frame(int index) = 0;
   /// The initial capacity, in entries, of each result buffer (hits, uncertain tests, duplicated
-  /// faces, pairs). A frame that finds more grows the buffers to what it found and traverses
-  /// again, so this changes speed, never results; tests set it small to exercise the growth.
+  /// faces, pairs) and of the walks' lists (subwalks, candidate pairs). A frame that finds more
+  /// grows the buffers to what it found and traverses again, so this changes speed, never
+  /// results; tests set it small to exercise the growth.
   /// It also caps the pairs and uncertain tests sorted by one block (at most 8192) before the
   /// device-wide sorts take over, so small values exercise that path too.
   virtual void set_result_capacity(int64_t entries) = 0;
