@@ -466,6 +466,16 @@ class CudaBackendImpl final : public CudaBackend {
   /// With some slack, so that a sequence whose counts creep up does not run every frame twice.
   static uint64_t grown(uint64_t count) { return count + count / 2 + 1024; }
 
+  /// Buffers for a run's counts with slack (grown), and the subwalk grid sized for them. Growing
+  /// discards the buffers' contents: after a frame's results are read, or before a run again.
+  void fit_counts(const FrameCounters& c) {
+    // c.expanded + c.duplicates bounds the pairs of every stored hit.
+    ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
+                           grown(c.expanded + c.duplicates), grown(c.listed_most),
+                           grown(c.subwalks_most));
+    subwalks_expected_ = grown(c.subwalks_most);
+  }
+
   /// The frame's degenerate flags and edge ownership on the device.
   const uint8_t* prepare_degenerate(std::span<const int32_t> degenerate);
   /// Edge ownership on the device for the degenerate triangles flagged there (flagged_).
@@ -541,7 +551,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint64_t> listed_;    // a check's candidate pairs, from its walks to its tests
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
-  uint64_t subwalks_expected_ = 1;     // the last frame's most subwalks, with slack
+  uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
@@ -646,8 +656,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
       const bool a_larger = part_size(check.a) >= part_size(check.b);
       const int32_t big = a_larger ? check.a : check.b, small = a_larger ? check.b : check.a;
       launch_cross_check(trees_[big]->view(), part_begin(big), trees_[small]->view(),
-                         part_begin(small), inputs, subwalks, listed, results, use, max_blocks_,
-                         s);
+                         part_begin(small), inputs, subwalks, listed, results, use, max_blocks_, s);
     }
     if (time_each) check_timers_[i]->stop_async(s);
   }
@@ -691,12 +700,11 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   detect::FilteredFrame frame;
   if (topo_.triangle_count == 0) return frame;
   const auto start = Clock::now();
-  const bool speculated = speculation_.queued && speculation_.call.use == use &&
-                          std::ranges::equal(speculation_.call.checks, checks) &&
-                          std::ranges::equal(speculation_.degenerate, degenerate) &&
-                          speculation_.builds == builds_ &&
-                          speculation_.positions == current_positions_ &&
-                          speculation_.versions == part_versions();
+  const bool speculated =
+      speculation_.queued && speculation_.call.use == use &&
+      std::ranges::equal(speculation_.call.checks, checks) &&
+      std::ranges::equal(speculation_.degenerate, degenerate) && speculation_.builds == builds_ &&
+      speculation_.positions == current_positions_ && speculation_.versions == part_versions();
   speculation_.queued = false;
   const uint8_t* owned = prepare_degenerate(degenerate);
   if (!speculated) queue_detect(use, checks, owned);
@@ -712,14 +720,11 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
         c.listed_most <= listed_.capacity() && c.subwalks_most <= subwalks_.capacity())
       break;
-    // c.expanded + c.duplicates bounds the pairs of every stored hit: the next run fits, but
-    // for the stages after one that overflowed: a subwalk list that overflowed left pairs
-    // unlisted, a candidate list that overflowed left hits unfound, so each undercounts the
-    // stages after it, and a frame can take up to four runs. None is ever lost.
-    ensure_result_capacity(grown(c.hits), grown(c.uncertain), grown(c.duplicates),
-                           grown(c.expanded + c.duplicates), grown(c.listed_most),
-                           grown(c.subwalks_most));
-    subwalks_expected_ = grown(c.subwalks_most);
+    // The next run fits, but for the stages after one that overflowed: a subwalk list that
+    // overflowed left pairs unlisted, a candidate list that overflowed left hits unfound, so
+    // each undercounts the stages after it, and a frame can take up to four runs. None is
+    // ever lost.
+    fit_counts(c);
     queue_detect(use, checks, owned);
   }
   collect_times();
@@ -812,23 +817,9 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) +
                          static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
   frame.classify_seconds = seconds_since(classify_start);
-  {
-    // Next frames start with this one's counts and some slack, so that creeping counts
-    // rarely run a frame twice. Only now: growing discards the buffers' contents.
-    const uint64_t hits = grown(c.hits), uncertain = grown(c.uncertain),
-                   duplicates = grown(c.duplicates), pairs = grown(c.expanded + c.duplicates),
-                   listed = grown(c.listed_most), subwalks = grown(c.subwalks_most);
-    subwalks_expected_ = subwalks;
-    if (hits > hits_.capacity() || uncertain > uncertain_.capacity() ||
-        duplicates > duplicates_.capacity() || pairs > pair_keys_.capacity() ||
-        listed > listed_.capacity() || subwalks > subwalks_.capacity())
-      ensure_result_capacity(std::max<uint64_t>(hits, hits_.capacity()),
-                             std::max<uint64_t>(uncertain, uncertain_.capacity()),
-                             std::max<uint64_t>(duplicates, duplicates_.capacity()),
-                             std::max<uint64_t>(pairs, pair_keys_.capacity()),
-                             std::max<uint64_t>(listed, listed_.capacity()),
-                             std::max<uint64_t>(subwalks, subwalks_.capacity()));
-  }
+  // Next frames start with this one's counts and some slack, so that creeping counts rarely
+  // run a frame twice (buffers never shrink).
+  fit_counts(c);
   return frame;
 }
 

@@ -93,12 +93,12 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
 /// A walk's listing (of candidate pairs, or of subwalks): its thread's keys held in a small
 /// local array and appended to the list a chunk at a time. Appending each key on its own
 /// serialised the walks on the list's counter. A full chunk, met inside the walk's divergent
-/// loop, is appended by its thread alone (one atomic per 16 keys: few walks list that many). The rest is appended once the walk is over
-/// (finish), by every thread at that one call site together: one atomic per group of converged
-/// threads. A group append inside the loop once counted pairs it never wrote: with boxes padded
-/// to 32 bytes (tried, and slower), the recompiled walk listed unwritten (zero) entries, caught
-/// by the tests and by memcheck in the pair tests. Not fully explained; a thread appending
-/// alone cannot be mistaken about which threads take part.
+/// loop, is appended by its thread alone (one atomic per 16 keys: few walks list that many). The
+/// rest is appended once the walk is over (finish), by every thread at that one call site together:
+/// one atomic per group of converged threads. A group append inside the loop once counted pairs it
+/// never wrote: with boxes padded to 32 bytes (tried, and slower), the recompiled walk listed
+/// unwritten (zero) entries, caught by the tests and by memcheck in the pair tests. Not fully
+/// explained; a thread appending alone cannot be mistaken about which threads take part.
 class KeyLister {
  public:
   static constexpr int kChunk = 16;
@@ -400,14 +400,14 @@ namespace {
 
 /// A launch whose item count is known only on the device, when it runs: a grid that covers
 /// `bound` items (a buffer's capacity, or a count expected) but no more than `max_blocks`, the
-/// kernel striding over the items the device counted. Capacities only grow: after one heavily folded frame, a grid
-/// sized by them would launch mostly idle blocks for every later one.
+/// kernel striding over the items the device counted. Capacities only grow: after one heavily
+/// folded frame, a grid sized by them would launch mostly idle blocks for every later one.
 template <class... Params, class... Args>
 void launch_counted(void (*kernel)(Params...), unsigned long long bound, unsigned max_blocks,
                     cudaStream_t stream, Args&&... args) {
   const unsigned long long needed = (bound + kBlock - 1) / kBlock;
-  const auto blocks = static_cast<unsigned>(std::max<unsigned long long>(
-      1, std::min<unsigned long long>(needed, max_blocks)));
+  const auto blocks = static_cast<unsigned>(
+      std::max<unsigned long long>(1, std::min<unsigned long long>(needed, max_blocks)));
   kernel<<<blocks, kBlock, 0, stream>>>(static_cast<Params>(args)...);
   SNAG_CUDA_CHECK_LAUNCH();
 }
@@ -431,8 +431,8 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
 void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
                      const SubwalkList& subwalks, const CandidateList& listed,
                      const ResultBuffers& results, cudaStream_t stream) {
-  launch_counted(subwalk_kernel, std::min(subwalks.expected, subwalks.capacity), ~0u, stream,
-                 tree, base, walked, subwalks, listed, results.counters);
+  launch_counted(subwalk_kernel, std::min(subwalks.expected, subwalks.capacity), ~0u, stream, tree,
+                 base, walked, subwalks, listed, results.counters);
 }
 
 unsigned walk_blocks(const bvh::TreeView& tree) {
@@ -460,8 +460,7 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
                         const CandidateList& listed, const ResultBuffers& results,
                         detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
-  const int32_t first_unopened =
-      bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
+  const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
   cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
       tree, base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
   SNAG_CUDA_CHECK_LAUNCH();

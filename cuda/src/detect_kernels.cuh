@@ -27,10 +27,10 @@ struct FrameCounters {
   unsigned long long degenerate;  ///< scan: certainly degenerate triangles
   unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
   unsigned long long pairs;  ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
-  unsigned long long listed;    ///< the current check's walks: candidate pairs they listed
-  unsigned long long subwalks;  ///< the current check's walks above the split level: the
-                                ///< subwalks they handed over (zeroed with `listed` before
-                                ///< each check, the two side by side)
+  unsigned long long listed;         ///< the current check's walks: candidate pairs they listed
+  unsigned long long subwalks;       ///< the current check's walks above the split level: the
+                                     ///< subwalks they handed over (zeroed with `listed` before
+                                     ///< each check, the two side by side)
   unsigned long long listed_most;    ///< the most any check of the frame listed (entries wanted
                                      ///< in the candidate list)
   unsigned long long subwalks_most;  ///< likewise for the subwalk list

@@ -113,6 +113,18 @@ SNAG_HD_INLINE void walk_subtree_read_ahead(const TreeView& tree, int32_t root, 
   }
 }
 
+/// Calls visit(leaf) with the node index of every leaf under `node` (itself, when it is one)
+/// whose box overlaps `box`; with `first_unopened`, also each overlapping node the walk does
+/// not open (walk_subtree_read_ahead).
+template <class Visit>
+SNAG_HD_INLINE void for_each_overlapping_leaf_under(TreeView tree, int32_t node,
+                                                    const geom::Box3f& box, Visit&& visit,
+                                                    int32_t first_unopened = INT32_MAX) {
+  walk_subtree_read_ahead(
+      tree, node, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit,
+      first_unopened);
+}
+
 /// Calls visit(leaf) with the node index of every leaf after `position` (in leaf order) whose
 /// box overlaps the leaf at `position`, so that each unordered pair of leaves is visited once,
 /// from the earlier one. For every ancestor reached from a left child, the right sibling's
@@ -130,19 +142,8 @@ SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t posit
   const geom::Box3f box = tree.boxes[leaf];
   for (int32_t node = leaf; node > 0; node = (node - 1) >> 1) {
     if (!(node & 1)) continue;  // a right child: nothing later under its parent's other side
-    walk_subtree_read_ahead(
-        tree, node + 1, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit,
-        first_unopened);
+    for_each_overlapping_leaf_under(tree, node + 1, box, visit, first_unopened);
   }
-}
-
-/// Calls visit(leaf) with the node index of every leaf under `node` (itself, when it is one)
-/// whose box overlaps `box`.
-template <class Visit>
-SNAG_HD_INLINE void for_each_overlapping_leaf_under(TreeView tree, int32_t node,
-                                                    const geom::Box3f& box, Visit&& visit) {
-  walk_subtree_read_ahead(
-      tree, node, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit);
 }
 
 /// The level at which a GPU splits each leaf's walk in two (the walks above it, then one
@@ -165,11 +166,9 @@ SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visi
 /// With `first_unopened`, visit also gets the overlapping nodes not opened, as in
 /// for_each_later_overlapping_leaf.
 template <class Visit>
-SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box,
-                                              Visit&& visit, int32_t first_unopened = INT32_MAX) {
-  walk_subtree_read_ahead(
-      tree, 0, [&](const geom::Box3f& other) { return geom::overlap(box, other); }, visit,
-      first_unopened);
+SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& box, Visit&& visit,
+                                              int32_t first_unopened = INT32_MAX) {
+  for_each_overlapping_leaf_under(tree, 0, box, visit, first_unopened);
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
@@ -275,12 +274,19 @@ struct LeafLanes {
         [&](int32_t i) { visit_leaf(bits(last), tree.triangle_at[tree.shape.position_of(i)]); });
   }
 
+  /// A visit_leaf for walk_leaves and for_each_later that calls visit(lane triangle, leaf's
+  /// triangle) for each lane in its bits.
+  template <class Visit>
+  auto each_lane(Visit& visit) const {
+    return [this, &visit](uint32_t lanes, int32_t other) {
+      for (; lanes; lanes &= lanes - 1) visit(triangle[count_trailing_zeros(lanes)], other);
+    };
+  }
+
   /// walk_leaves, calling visit(lane triangle, leaf's triangle) for each overlapping lane.
   template <class Visit>
   void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
-    walk_leaves(tree, root, [&](uint32_t lanes, int32_t other) {
-      for (; lanes; lanes &= lanes - 1) visit(triangle[count_trailing_zeros(lanes)], other);
-    });
+    walk_leaves(tree, root, each_lane(visit));
   }
 
   /// The query of for_each_later_overlap for every member at once (this group's node is
@@ -308,9 +314,7 @@ struct LeafLanes {
 template <class Visit>
 inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
   const LeafLanes lanes(tree, group);
-  lanes.for_each_later(tree, group, [&](uint32_t bits, int32_t other) {
-    for (; bits; bits &= bits - 1) visit(lanes.triangle[count_trailing_zeros(bits)], other);
-  });
+  lanes.for_each_later(tree, group, lanes.each_lane(visit));
 }
 
 /// for_each_overlap for the (up to four) leaves under node `group` of `tree` (group_level())
