@@ -56,10 +56,13 @@ class CudaBackendImpl final : public CudaBackend {
     max_blocks_ = static_cast<unsigned>(std::max(prop.multiProcessorCount, 1)) * 8u;
     stream_ = std::make_unique<Stream>();
     upload_stream_ = std::make_unique<Stream>();
-    configure_kernels();
     counters_.reserve(1);
     counters_host_.reserve(1);
     scan_counters_host_.reserve(1);
+    finish_ranks_.reserve(2 * kFinishLimit);
+    finish_tickets_.reserve(2 * kFinishSlices);
+    SNAG_CUDA_CHECK(cudaMemset(finish_ranks_.data(), 0, 2 * kFinishLimit * sizeof(unsigned)));
+    SNAG_CUDA_CHECK(cudaMemset(finish_tickets_.data(), 0, 2 * kFinishSlices * sizeof(unsigned)));
   }
 
   ~CudaBackendImpl() override {
@@ -137,7 +140,8 @@ class CudaBackendImpl final : public CudaBackend {
       check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
                            initial_capacity_, initial_capacity_, initial_capacity_);
-    subwalks_expected_ = static_cast<uint64_t>(initial_capacity_);
+    subwalks_expected_ = expand_expected_ = static_cast<uint64_t>(initial_capacity_);
+    finish_expected_ = kFinishLimit;
     stream_->synchronize();
   }
 
@@ -474,6 +478,9 @@ class CudaBackendImpl final : public CudaBackend {
                            grown(c.expanded + c.duplicates), grown(c.listed_most),
                            grown(c.subwalks_most));
     subwalks_expected_ = grown(c.subwalks_most);
+    expand_expected_ = grown(c.hits + c.duplicates);
+    // Any count fits the ranking's grid (it strides): sized for the last frame's, without slack.
+    finish_expected_ = std::max(c.pairs, c.uncertain);
   }
 
   /// The frame's degenerate flags and edge ownership on the device.
@@ -552,12 +559,15 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
   uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
+  uint64_t expand_expected_ = 1;     // its hits and duplicates, with slack
+  uint64_t finish_expected_ = 1;     // its pairs or uncertain tests, the more
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
   DeviceBuffer<uint64_t> pair_keys_, keys_alt_, tasks_alt_;
   DeviceBuffer<uint8_t> pair_status_, status_alt_;
   DeviceBuffer<unsigned char> temp_;
+  DeviceBuffer<unsigned> finish_ranks_, finish_tickets_;  // FinishScratch, zero between runs
   // Results in host memory: written by finish_kernel (small frames) or copied (large ones).
   PinnedBuffer<uint64_t> host_keys_, host_uncertain_, keys_host_, uncertain_host_;
   PinnedBuffer<uint8_t> host_status_, status_host_;
@@ -635,18 +645,18 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
   HostResults out = host_results_;
   out.limit = finish_limit_;
-  SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-  SNAG_CUDA_CHECK(
-      cudaMemsetAsync(table_.data(), 0xff, table_.capacity() * sizeof(unsigned long long), s));
+  launch_clear_frame(counters_.data(), table_.data(), table_.capacity(), s);
   const bool time_each = checks.size() > 1;
   for (size_t i = 0; i < checks.size(); ++i) {
     const detect::PartCheck check = topology_->checks[checks[i]];
     if (time_each) check_timers_[i]->start(s);
-    // Each check lists its subwalks and candidates from the start of their lists.
+    // Each check lists its subwalks and candidates from the start of their lists (the first
+    // finds them cleared with the rest).
     static_assert(offsetof(FrameCounters, subwalks) ==
                   offsetof(FrameCounters, listed) + sizeof(unsigned long long));
-    SNAG_CUDA_CHECK(
-        cudaMemsetAsync(&counters_.data()->listed, 0, 2 * sizeof(unsigned long long), s));
+    if (i > 0)
+      SNAG_CUDA_CHECK(
+          cudaMemsetAsync(&counters_.data()->listed, 0, 2 * sizeof(unsigned long long), s));
     if (check.self()) {
       if (part_size(check.a) > 0)
         launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, subwalks, listed,
@@ -662,11 +672,11 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   }
   narrow_timer_.stop_async(s);
   launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
-                counters_.data(), topo_.edge_face_offsets.data(), topo_.edge_faces.data(),
-                topo_.degenerate.data(), pair_bits_, current_positions_, topo_.triangles.data(),
-                set, max_blocks_, s);
-  launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), 2 * pair_bits_,
-                32 + edge_bits_, out, s);
+                expand_expected_, counters_.data(), topo_.edge_face_offsets.data(),
+                topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_, current_positions_,
+                topo_.triangles.data(), set, max_blocks_, s);
+  launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), finish_expected_,
+                {finish_ranks_.data(), finish_tickets_.data()}, out, s);
   detect_timer_.stop_async(s);
 }
 

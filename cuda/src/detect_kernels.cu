@@ -5,8 +5,6 @@
 
 #include <algorithm>
 
-#include <cub/block/block_radix_sort.cuh>
-
 #include "launch.cuh"
 #include "snag/geom/narrow_phase.h"
 
@@ -16,16 +14,20 @@ namespace {
 
 namespace cg = cooperative_groups;
 
-/// Appends `value` at the next slot of `array`: one atomic per group of converged threads
-/// (warp-aggregated), not one per result. Past `capacity` only the counter moves.
-__device__ __forceinline__ void append(uint64_t* array, unsigned long long capacity,
-                                       unsigned long long* counter, uint64_t value) {
+/// The calling thread's slot of *counter, which counts one per call: one atomic per group of
+/// converged threads (warp-aggregated), not one per call.
+__device__ __forceinline__ unsigned long long claim_slot(unsigned long long* counter) {
   const cg::coalesced_group group = cg::coalesced_threads();
   unsigned long long base = 0;
   if (group.thread_rank() == 0)
     base = atomicAdd(counter, static_cast<unsigned long long>(group.size()));
-  base = group.shfl(base, 0);
-  const unsigned long long at = base + group.thread_rank();
+  return group.shfl(base, 0) + group.thread_rank();
+}
+
+/// Appends `value` at the next slot of `array`. Past `capacity` only the counter moves.
+__device__ __forceinline__ void append(uint64_t* array, unsigned long long capacity,
+                                       unsigned long long* counter, uint64_t value) {
+  const unsigned long long at = claim_slot(counter);
   if (at < capacity) array[at] = value;
 }
 
@@ -62,6 +64,16 @@ __device__ __forceinline__ void add_warp_total(unsigned long long value,
   for (int offset = 16; offset > 0; offset >>= 1)
     value += __shfl_down_sync(0xffffffffu, value, offset);
   if ((threadIdx.x & 31) == 0 && value) atomicAdd(total, value);
+}
+
+/// A detect run's start: its counters zeroed and every slot of the pair set's table emptied,
+/// in one launch where two memsets were two steps of the stream.
+__global__ void clear_frame_kernel(FrameCounters* counters, unsigned long long* table,
+                                   unsigned long long table_size) {
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
+  if (first == 0) *counters = FrameCounters{};
+  for (unsigned long long i = first; i < table_size; i += stride) table[i] = kEmptyKey;
 }
 
 __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles,
@@ -241,7 +253,9 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
     if (was == kEmptyKey) break;
     slot = (slot + 1) & set.table_mask;
   }
-  const unsigned long long at = atomicAdd(&counters->pairs, 1ull);
+  // Aggregated: one counter for every insertion of the frame, each its own atomic had
+  // serialised them.
+  const unsigned long long at = claim_slot(&counters->pairs);
   if (at >= set.pair_capacity) return;  // counted: the host grows the buffers and runs again
   const int32_t a = static_cast<int32_t>(key >> bits);
   const int32_t b = static_cast<int32_t>(key & ((1ull << bits) - 1));
@@ -285,99 +299,82 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
   }
 }
 
-template <int kItems>
-using FinishPairSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kItems, uint8_t>;
-template <int kItems>
-using FinishTaskSort = cub::BlockRadixSort<uint64_t, kFinishThreads, kItems>;
-
-/// Shared memory of finish_kernel: the largest sort's (more than the static 48 KB, so dynamic).
-constexpr size_t kFinishShared = sizeof(typename FinishPairSort<kFinishItems>::TempStorage) >
-                                         sizeof(typename FinishTaskSort<kFinishItems>::TempStorage)
-                                     ? sizeof(typename FinishPairSort<kFinishItems>::TempStorage)
-                                     : sizeof(typename FinishTaskSort<kFinishItems>::TempStorage);
-
-/// Sorts `count` (at most kFinishThreads * kItems) pairs of the set by key into `out`.
-template <int kItems>
-__device__ void sort_pairs(const PairSet& set, unsigned long long count, int key_bits,
-                           const HostResults& out, unsigned char* shared) {
-  uint64_t keys[kItems];
-  uint8_t status[kItems];
-  for (int k = 0; k < kItems; ++k) {
-    const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kItems + k;
-    keys[k] = at < count ? set.keys[at] : kEmptyKey;  // the empty key sorts last
-    status[k] = at < count ? set.status[at] : 0;
-  }
-  using Sort = FinishPairSort<kItems>;
-  Sort(*reinterpret_cast<typename Sort::TempStorage*>(shared))
-      .SortBlockedToStriped(keys, status, 0, key_bits);
-  for (int k = 0; k < kItems; ++k) {
-    const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
-    if (at < count) {
-      out.keys[at] = keys[k];
-      out.status[at] = status[k];
+/// Ranks `count` distinct keys (at most kFinishLimit) and hands each, with its index and rank
+/// (the count of smaller keys: its place in sorted order), to write(i, key, rank). Block (x,
+/// y) of the grid compares the keys of slice x (kFinishThreads of them, one per thread)
+/// against those of slice y, and adds what it counted into ranks[]; the last block done with
+/// a slice (a ticket per slice) writes its keys out. A grid of fewer blocks strides over the
+/// slices. Both arrays are zero before and after. Keys are distinct, so the ranks are a
+/// permutation and the output is the sort's.
+template <class Write>
+__device__ void write_ranked(const uint64_t* keys, unsigned long long count, unsigned* ranks,
+                             unsigned* tickets, Write&& write) {
+  __shared__ uint64_t slice_keys[kFinishThreads];
+  __shared__ bool last;
+  const auto slices = static_cast<unsigned>((count + kFinishThreads - 1) / kFinishThreads);
+  for (unsigned slice = blockIdx.x; slice < slices; slice += gridDim.x) {
+    const unsigned long long i =
+        static_cast<unsigned long long>(slice) * kFinishThreads + threadIdx.x;
+    const uint64_t mine = i < count ? keys[i] : kEmptyKey;
+    unsigned rank = 0;
+    for (unsigned other = blockIdx.y; other < slices; other += gridDim.y) {
+      const unsigned long long j =
+          static_cast<unsigned long long>(other) * kFinishThreads + threadIdx.x;
+      __syncthreads();                                            // the last slice's keys are read
+      slice_keys[threadIdx.x] = j < count ? keys[j] : kEmptyKey;  // the empty key ranks last
+      __syncthreads();
+#pragma unroll 16
+      for (int k = 0; k < kFinishThreads; ++k) rank += slice_keys[k] < mine;
     }
-  }
-  __syncthreads();  // the shared memory is the next sort's
-}
-
-/// Sorts `count` (at most kFinishThreads * kItems) uncertain tests into `out`.
-template <int kItems>
-__device__ void sort_tasks(const uint64_t* uncertain, unsigned long long count, int task_bits,
-                           const HostResults& out, unsigned char* shared) {
-  uint64_t keys[kItems];
-  for (int k = 0; k < kItems; ++k) {
-    const unsigned long long at = static_cast<unsigned long long>(threadIdx.x) * kItems + k;
-    keys[k] = at < count ? uncertain[at] : kEmptyKey;
-  }
-  using Sort = FinishTaskSort<kItems>;
-  Sort(*reinterpret_cast<typename Sort::TempStorage*>(shared))
-      .SortBlockedToStriped(keys, 0, task_bits);
-  for (int k = 0; k < kItems; ++k) {
-    const unsigned long long at = static_cast<unsigned long long>(k) * kFinishThreads + threadIdx.x;
-    if (at < count) out.uncertain[at] = keys[k];
+    if (i < count && rank) atomicAdd(&ranks[i], rank);
+    __threadfence();  // the block's ranks are counted before its ticket is
+    __syncthreads();
+    if (threadIdx.x == 0) last = atomicAdd(&tickets[slice], 1u) == gridDim.y - 1;
+    __syncthreads();
+    if (last) {
+      if (threadIdx.x == 0) tickets[slice] = 0;
+      if (i < count) write(i, mine, atomicExch(&ranks[i], 0u));
+    }
+    __syncthreads();  // `last` is the next slice's
   }
 }
 
-/// Calls sort(Items<k>{}) with the fewest keys per thread k of 1, 2, 4 or kFinishItems that
-/// hold `count` keys in one block (a sort's passes cost in proportion to k).
-template <int k>
-struct Items {
-  static constexpr int value = k;
-};
-template <class Sort>
-__device__ void sort_with_fewest_items(unsigned long long count, Sort&& sort) {
-  constexpr unsigned long long threads = kFinishThreads;
-  if (count <= threads)
-    sort(Items<1>{});
-  else if (count <= 2 * threads)
-    sort(Items<2>{});
-  else if (count <= 4 * threads)
-    sort(Items<4>{});
-  else
-    sort(Items<kFinishItems>{});
-}
-
-/// The frame's results to host memory: small sets sorted in shared memory (keys are distinct,
-/// so the order is total and the block's output is the device-wide sort's), the counters last.
+/// The frame's results to host memory: when they fit (out.limit), the pairs (grid layer z =
+/// 0) and the uncertain tests (z = 1) in sorted order, each ranked by its layer's blocks
+/// together (write_ranked), the two side by side; the counters by block (0, 0, 0).
 __global__ void __launch_bounds__(kFinishThreads)
     finish_kernel(const FrameCounters* counters, PairSet set, const uint64_t* uncertain,
-                  unsigned long long uncertain_capacity, int key_bits, int task_bits,
-                  HostResults out) {
-  extern __shared__ __align__(16) unsigned char shared[];
-  const FrameCounters c = *counters;
+                  unsigned long long uncertain_capacity, FinishScratch scratch, HostResults out) {
   const unsigned long long limit = min(out.limit, kFinishLimit);
-  if (c.pairs > 0 && c.pairs <= limit && c.pairs <= set.pair_capacity)
-    sort_with_fewest_items(c.pairs, [&](auto items) {
-      sort_pairs<decltype(items)::value>(set, c.pairs, key_bits, out, shared);
-    });
-  if (c.uncertain > 0 && c.uncertain <= limit && c.uncertain <= uncertain_capacity)
-    sort_with_fewest_items(c.uncertain, [&](auto items) {
-      sort_tasks<decltype(items)::value>(uncertain, c.uncertain, task_bits, out, shared);
-    });
-  if (threadIdx.x == 0) *out.counters = c;
+  if (blockIdx.z == 0) {
+    const unsigned long long pairs = counters->pairs;
+    if (blockIdx.x == 0 && blockIdx.y == 0 && threadIdx.x == 0) *out.counters = *counters;
+    if (pairs > 0 && pairs <= limit && pairs <= set.pair_capacity)
+      write_ranked(set.keys, pairs, scratch.ranks, scratch.tickets,
+                   [&](unsigned long long i, uint64_t key, unsigned rank) {
+                     out.keys[rank] = key;
+                     out.status[rank] = set.status[i];
+                   });
+  } else {
+    const unsigned long long tasks = counters->uncertain;
+    if (tasks > 0 && tasks <= limit && tasks <= uncertain_capacity)
+      write_ranked(
+          uncertain, tasks, scratch.ranks + kFinishLimit, scratch.tickets + kFinishSlices,
+          [&](unsigned long long, uint64_t key, unsigned rank) { out.uncertain[rank] = key; });
+  }
 }
 
 }  // namespace
+
+void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
+                        unsigned long long table_size, cudaStream_t stream) {
+  // Four table slots per thread, at most 512 blocks: the table is 2^17 slots for most frames.
+  const unsigned long long blocks =
+      std::clamp<unsigned long long>((table_size + 4 * kBlock - 1) / (4 * kBlock), 1, 512);
+  clear_frame_kernel<<<static_cast<unsigned>(blocks), kBlock, 0, stream>>>(counters, table,
+                                                                           table_size);
+  SNAG_CUDA_CHECK_LAUNCH();
+}
 
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
                             int32_t n, int32_t* degenerate, int32_t* uncertain,
@@ -470,25 +467,23 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
 
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
                    const uint64_t* duplicates, unsigned long long duplicate_capacity,
-                   FrameCounters* counters, const int32_t* edge_face_offsets,
-                   const int32_t* edge_faces, const uint8_t* degenerate, int bits,
-                   const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
-                   unsigned max_blocks, cudaStream_t stream) {
-  launch_counted(expand_kernel, hit_capacity + duplicate_capacity, max_blocks, stream, hits,
-                 hit_capacity, duplicates, duplicate_capacity, counters, edge_face_offsets,
-                 edge_faces, degenerate, bits, positions, triangles, set);
-}
-
-void configure_kernels() {
-  SNAG_CUDA_CHECK(cudaFuncSetAttribute(finish_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                                       static_cast<int>(kFinishShared)));
+                   unsigned long long expected, FrameCounters* counters,
+                   const int32_t* edge_face_offsets, const int32_t* edge_faces,
+                   const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
+                   const geom::Tri* triangles, const PairSet& set, unsigned max_blocks,
+                   cudaStream_t stream) {
+  launch_counted(expand_kernel, std::min(expected, hit_capacity + duplicate_capacity), max_blocks,
+                 stream, hits, hit_capacity, duplicates, duplicate_capacity, counters,
+                 edge_face_offsets, edge_faces, degenerate, bits, positions, triangles, set);
 }
 
 void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
-                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
-                   const HostResults& out, cudaStream_t stream) {
-  finish_kernel<<<1, kFinishThreads, kFinishShared, stream>>>(
-      counters, set, uncertain, uncertain_capacity, key_bits, task_bits, out);
+                   unsigned long long uncertain_capacity, unsigned long long expected,
+                   const FinishScratch& scratch, const HostResults& out, cudaStream_t stream) {
+  const auto slices = static_cast<unsigned>(std::clamp<unsigned long long>(
+      (expected + kFinishThreads - 1) / kFinishThreads, 1, kFinishSlices));
+  finish_kernel<<<dim3(slices, slices, 2), kFinishThreads, 0, stream>>>(
+      counters, set, uncertain, uncertain_capacity, scratch, out);
   SNAG_CUDA_CHECK_LAUNCH();
 }
 

@@ -81,11 +81,22 @@ struct HostResults {
   unsigned long long limit = 0;
 };
 
-/// One block sorts at most this many pairs (and uncertain tests) in shared memory; frames with
-/// more go through CUB's device-wide sort after the host has read the counts.
-inline constexpr int kFinishThreads = 1024;
-inline constexpr int kFinishItems = 8;
-inline constexpr unsigned long long kFinishLimit = kFinishThreads * kFinishItems;
+/// finish_kernel ranks at most kFinishLimit pairs (and as many uncertain tests), comparing
+/// every key with every other, kFinishThreads against kFinishThreads per block; frames with
+/// more go through CUB's device-wide sort after the host has read the counts. At 3K pairs the
+/// ranking takes a few microseconds over ~150 blocks, where one block's radix sort (CUB's
+/// BlockRadixSort, 1024 threads) took 20 and did not shorten with other shapes (cuda/NOTES.md).
+inline constexpr int kFinishThreads = 256;
+inline constexpr unsigned kFinishSlices = 32;
+inline constexpr unsigned long long kFinishLimit = kFinishThreads * kFinishSlices;
+
+/// finish_kernel's scratch, all zero between launches (each launch leaves it so): the ranks
+/// being counted, kFinishLimit for the pairs then as many for the uncertain tests; the blocks
+/// done with each slice of kFinishThreads keys, kFinishSlices for each.
+struct FinishScratch {
+  unsigned* ranks = nullptr;
+  unsigned* tickets = nullptr;
+};
 
 /// Where the narrow phase appends its results. Hits and uncertain tests are (edge << 32 |
 /// triangle) keys, duplicated faces (a << 32 | b) keys with a < b.
@@ -105,8 +116,10 @@ struct PairInputs {
   const uint8_t* degenerate = nullptr;  ///< per triangle, 1 when left out this frame
 };
 
-/// Kernel attributes (finish_kernel's shared memory) on the current device: once per backend.
-void configure_kernels();
+/// Zeroes *counters and fills the pair set's table (table_size slots) with kEmptyKey: the
+/// start of every detect run.
+void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
+                        unsigned long long table_size, cudaStream_t stream);
 
 /// Degenerate-triangle scan of triangles [first, first + n): appends ids the filter finds
 /// degenerate to `degenerate` and ids it cannot decide to `uncertain` (both in any order),
@@ -158,20 +171,23 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
 /// triangle itself, and every duplicated face pair, made distinct in `set` and classified with
 /// the double filter (detect::is_crossing) once each. Reads the counts from `counters` (the
-/// narrow phase's), so it can be queued before they are known: at most `max_blocks` blocks
-/// stride over the stored entries; entries past a count or past a capacity are not read.
+/// narrow phase's), so it can be queued before they are known: a grid for the `expected` count
+/// (at most `max_blocks` blocks) strides over the stored entries; entries past a count or past
+/// a capacity are not read.
 void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
                    const uint64_t* duplicates, unsigned long long duplicate_capacity,
-                   FrameCounters* counters, const int32_t* edge_face_offsets,
-                   const int32_t* edge_faces, const uint8_t* degenerate, int bits,
-                   const geom::Vec3d* positions, const geom::Tri* triangles, const PairSet& set,
-                   unsigned max_blocks, cudaStream_t stream);
+                   unsigned long long expected, FrameCounters* counters,
+                   const int32_t* edge_face_offsets, const int32_t* edge_faces,
+                   const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
+                   const geom::Tri* triangles, const PairSet& set, unsigned max_blocks,
+                   cudaStream_t stream);
 
-/// One block: when the frame's pairs and uncertain tests each fit in the block (and in
-/// out.limit), sorts them (pairs by key over key_bits, uncertain tests by (edge, triangle) over
-/// task_bits) and writes them to `out`; always copies the counters to out.counters.
+/// When the frame's pairs and uncertain tests each fit (out.limit, at most kFinishLimit),
+/// writes them to `out` in sorted order (pairs by key, uncertain tests by (edge, triangle));
+/// always copies the counters to out.counters. The grid is sized for `expected` keys (the
+/// larger count of the last frame); any count up to the limit is written.
 void launch_finish(const FrameCounters* counters, const PairSet& set, const uint64_t* uncertain,
-                   unsigned long long uncertain_capacity, int key_bits, int task_bits,
-                   const HostResults& out, cudaStream_t stream);
+                   unsigned long long uncertain_capacity, unsigned long long expected,
+                   const FinishScratch& scratch, const HostResults& out, cudaStream_t stream);
 
 }  // namespace snag::cuda

@@ -109,24 +109,23 @@ __global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_
   out[base + to] = t;
 }
 
-/// The leaf at position p fit to its triangle, whose plane the narrow phase reads (computed
-/// here, where the corners are loaded anyway, instead of in a launch of its own).
-__device__ __forceinline__ int32_t refit_leaf_and_plane(const bvh::TreeView& tree,
-                                                        const mesh::MeshView& mesh,
-                                                        geom::PlaneCoefficients* planes,
-                                                        int32_t p) {
-  const int32_t leaf = tree.shape.leaf_at(p);
-  bvh::refit_leaf(leaf, tree, mesh);
+/// The box of the leaf at position p, from its triangle, whose plane the narrow phase reads
+/// (computed here, where the corners are loaded anyway, instead of in a launch of its own).
+__device__ __forceinline__ geom::Box3f fit_leaf_and_plane(const bvh::TreeView& tree,
+                                                          const mesh::MeshView& mesh,
+                                                          geom::PlaneCoefficients* planes,
+                                                          int32_t p) {
   const int32_t t = tree.triangle_at[p];
-  planes[t] = detect::triangle_plane(mesh.positions, mesh.triangles[t]);
-  return leaf;
+  const geom::Tri tri = mesh.triangles[t];
+  planes[t] = detect::triangle_plane(mesh.positions, tri);
+  return bvh::leaf_box(tri, mesh);
 }
 
 __global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh,
                                     geom::PlaneCoefficients* planes) {
   const int32_t n = tree.shape.leaf_count;
   const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (p < n) refit_leaf_and_plane(tree, mesh, planes, p);
+  if (p < n) tree.boxes[tree.shape.leaf_at(p)] = fit_leaf_and_plane(tree, mesh, planes, p);
 }
 
 __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t last) {
@@ -134,56 +133,142 @@ __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t la
   if (node < last) bvh::refit_internal(node, tree);
 }
 
-/// One launch: each leaf's thread fits its leaf, then climbs while it is the second child to
-/// arrive at the parent (counter per node). The first to arrive stops; the second finds the
-/// sibling's box complete: the sibling's writer made its box visible (__threadfence) before
-/// its atomicAdd, and the box is read from L2 (__ldcg), past a possibly stale L1 line. The
-/// second arrival resets the counter, so every counter is zero again after the launch.
-__global__ void refit_climb_kernel(bvh::TreeView tree, mesh::MeshView mesh,
-                                   geom::PlaneCoefficients* planes, uint32_t* counters) {
-  const int32_t n = tree.shape.leaf_count;
-  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (p >= n) return;
-  int32_t node = refit_leaf_and_plane(tree, mesh, planes, p);
-  while (node > 0) {
-    const int32_t parent = (node - 1) >> 1;
-    __threadfence();
-    if (atomicAdd(&counters[parent], 1u) == 0) return;
-    counters[parent] = 0;
-    geom::Box3f children[2];
-    for (int c = 0; c < 2; ++c) {
-      const float* src = reinterpret_cast<const float*>(tree.boxes + 2 * parent + 1 + c);
-      float* dst = reinterpret_cast<float*>(&children[c]);
-      for (int k = 0; k < 6; ++k) dst[k] = __ldcg(src + k);
+/// The refit in one launch, a CUDA block per subtree of kRefitLevels levels: the block of the
+/// node at offset blockIdx.x of level top = depth - kRefitLevels (0 for small trees) fits its
+/// subtree's nodes level by level from the deepest up, each level's boxes kept in shared memory
+/// for the next, with a block barrier between levels. The last block to finish (a ticket, as
+/// the quality's) fits the levels above `top` from the blocks' roots the same way. Each box is
+/// geom::merge of the same two children or bvh::leaf_box, so the CPU's bits.
+/// It replaced a climb (one thread per leaf going up while it was the second child to arrive,
+/// an atomic and a fence per level: 16 dependent steps through L2 at 36K, 22.5 us) with about
+/// kRefitLevels block barriers and one ticket.
+constexpr int kRefitLevels = 9;
+constexpr int kRefitWidth = 1 << kRefitLevels;  // nodes of a subtree's deepest level
+constexpr int kRefitThreads = kRefitWidth;
+
+/// Boxes of one level of a subtree being fit, and of the level above it: the level widths halve
+/// going up, so two buffers of kRefitWidth and kRefitWidth / 2 boxes take turns.
+struct RefitLevels {
+  geom::Box3f wide[kRefitWidth];
+  geom::Box3f narrow[kRefitWidth / 2];
+};
+
+/// The box of `node` from its children's boxes at `children` (the level below's, indexed from
+/// that level's first node of this subtree) or, for a leaf, from its triangle.
+__device__ __forceinline__ geom::Box3f fit_node(const bvh::TreeView& tree,
+                                                const mesh::MeshView& mesh,
+                                                geom::PlaneCoefficients* planes, int32_t node,
+                                                const geom::Box3f* children, int32_t j) {
+  if (!tree.shape.is_leaf(node)) return geom::merge(children[2 * j], children[2 * j + 1]);
+  return fit_leaf_and_plane(tree, mesh, planes, tree.shape.position_of(node));
+}
+
+/// A box written by another SM in this launch: read from L2 (__ldcg), past a possibly stale
+/// L1 line.
+__device__ __forceinline__ geom::Box3f load_from_l2(const geom::Box3f* box) {
+  geom::Box3f loaded;
+  const float* src = reinterpret_cast<const float*>(box);
+  float* dst = reinterpret_cast<float*>(&loaded);
+  for (int k = 0; k < 6; ++k) dst[k] = __ldcg(src + k);
+  return loaded;
+}
+
+__global__ void __launch_bounds__(kRefitThreads)
+    refit_subtrees_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
+                          int32_t top, unsigned* ticket) {
+  __shared__ RefitLevels levels;
+  __shared__ bool last;
+  const CompleteTree& shape = tree.shape;
+  const int32_t nodes = shape.node_count();
+  const int32_t offset = static_cast<int32_t>(blockIdx.x);
+  geom::Box3f* below = levels.narrow;  // unused at the deepest level (all leaves)
+  geom::Box3f* here = levels.wide;
+  for (int32_t level = shape.depth; level >= top; --level) {
+    const int32_t width = 1 << (level - top);
+    const int32_t first = CompleteTree::level_begin(level) + offset * width;
+    for (int32_t j = static_cast<int32_t>(threadIdx.x); j < width; j += kRefitThreads) {
+      const int32_t node = first + j;
+      if (node >= nodes) break;  // the deepest level ends early
+      const geom::Box3f box = fit_node(tree, mesh, planes, node, below, j);
+      tree.boxes[node] = box;
+      here[j] = box;
     }
-    tree.boxes[parent] = geom::merge(children[0], children[1]);
-    node = parent;
+    __syncthreads();
+    below = here;
+    here = here == levels.wide ? levels.narrow : levels.wide;
+  }
+  if (top == 0) return;
+
+  // The levels above: the last block, once every block's root is stored.
+  __threadfence();
+  if (threadIdx.x == 0) last = atomicAdd(ticket, 1u) == gridDim.x - 1;
+  __syncthreads();
+  if (!last) return;
+  if (threadIdx.x == 0) *ticket = 0;
+  // Levels wider than the buffers (above 2^18 triangles) through L2, then the rest in shared
+  // memory from the first level that fits.
+  int32_t level = top;
+  for (; (1 << level) > kRefitWidth; --level) {
+    const int32_t first = CompleteTree::level_begin(level - 1);
+    for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << (level - 1));
+         j += kRefitThreads) {
+      const int32_t node = first + j;
+      tree.boxes[node] = geom::merge(load_from_l2(tree.boxes + 2 * node + 1),
+                                     load_from_l2(tree.boxes + 2 * node + 2));
+    }
+    __syncthreads();
+  }
+  below = levels.wide;
+  here = levels.narrow;
+  for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << level); j += kRefitThreads)
+    below[j] = load_from_l2(tree.boxes + CompleteTree::level_begin(level) + j);
+  __syncthreads();
+  for (--level; level >= 0; --level) {
+    const int32_t first = CompleteTree::level_begin(level);
+    for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << level); j += kRefitThreads) {
+      const geom::Box3f box = geom::merge(below[2 * j], below[2 * j + 1]);
+      tree.boxes[first + j] = box;
+      here[j] = box;
+    }
+    __syncthreads();
+    geom::Box3f* const filled = here;
+    here = below;
+    below = filled;
   }
 }
 
 /// The quality in one launch, one CUDA block per block of bvh::kQualityBlock internal nodes:
-/// the block's threads compute the half areas side by side into shared memory, then one thread
-/// adds them in the CPU's order (bvh::quality_block_sum: the same half_area, the same
-/// sequential additions, so the same bits), reading shared memory instead of waiting on a
-/// global load per node (that wait made it 0.26 ms at 36K, 3 ms at 1M). The last block to
-/// finish adds the block sums in order (bvh::quality_from_blocks) and resets the ticket.
+/// the block's threads compute the half areas side by side into shared memory, then the first
+/// warp adds them in the CPU's order (bvh::quality_block_sum: a lane's partial sum per thread,
+/// then lane 0 adding the partial sums in order; the same half_area and the same additions,
+/// so the same bits), reading shared memory instead of waiting on a global load per node (that
+/// wait made it 0.26 ms at 36K, 3 ms at 1M). The last block to finish adds the block sums in
+/// order (bvh::quality_from_blocks) and resets the ticket.
 __global__ void __launch_bounds__(kQualityThreads)
     quality_kernel(const geom::Box3f* boxes, bvh::CompleteTree shape, int32_t blocks,
                    double* block_sums, unsigned* ticket, double* out) {
+  static_assert(bvh::kQualityLanes == 32, "a block's lanes are one warp's threads");
   __shared__ double areas[bvh::kQualityBlock];
   __shared__ bool last;
   const int32_t block = static_cast<int32_t>(blockIdx.x);
   const int32_t begin = block * bvh::kQualityBlock;
-  const int32_t end = min(begin + bvh::kQualityBlock, shape.leaf_count - 1);
-  for (int32_t k = static_cast<int32_t>(threadIdx.x); k < end - begin; k += kQualityThreads)
+  const int32_t count = bvh::quality_block_size(shape, block);
+  for (int32_t k = static_cast<int32_t>(threadIdx.x); k < count; k += kQualityThreads)
     areas[k] = geom::half_area(boxes[begin + k]);
   __syncthreads();
-  if (threadIdx.x == 0) {
-    double sum = 0.0;
-    for (int32_t k = 0; k < end - begin; ++k) sum += areas[k];
-    block_sums[block] = sum;
-    __threadfence();  // the sum is visible device-wide before the ticket counts it
-    last = atomicAdd(ticket, 1u) == static_cast<unsigned>(blocks - 1);
+  if (threadIdx.x < bvh::kQualityLanes) {
+    const int32_t lane = static_cast<int32_t>(threadIdx.x);
+    const double partial = bvh::quality_lane_sum([&](int32_t k) { return areas[k]; }, count, lane);
+    __syncwarp();
+    areas[lane] = partial;  // every lane has read what it needed of areas[]
+    __syncwarp();
+    if (lane == 0) {
+      double sum = 0.0;
+      for (int32_t l = 0; l < bvh::kQualityLanes; ++l) sum += areas[l];
+      block_sums[block] = sum;
+      __threadfence();  // the sum is visible device-wide before the ticket counts it
+      last = atomicAdd(ticket, 1u) == static_cast<unsigned>(blocks - 1);
+    }
   }
   __syncthreads();
   if (!last || threadIdx.x != 0) return;
@@ -202,8 +287,8 @@ void DeviceTree::resize(int32_t n) {
   const size_t count = static_cast<size_t>(n);
   boxes_.reserve(2 * count - 1);
   triangle_at_.reserve(count);
-  refit_counters_.reserve(count);
-  SNAG_CUDA_CHECK(cudaMemset(refit_counters_.data(), 0, count * sizeof(uint32_t)));
+  refit_ticket_.reserve(1);
+  SNAG_CUDA_CHECK(cudaMemset(refit_ticket_.data(), 0, sizeof(unsigned)));
   centroids_.reserve(count);
   lists_.reserve(3 * count);
   lists_alt_.reserve(3 * count);
@@ -262,7 +347,10 @@ void DeviceTree::refit(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cud
   if (n == 0) return;
   const bvh::TreeView tree = view();
   if (!level_by_level_refit) {
-    launch(refit_climb_kernel, n, stream, tree, mesh, planes, refit_counters_.data());
+    const int32_t top = std::max(0, shape_.depth - kRefitLevels);
+    refit_subtrees_kernel<<<1u << top, kRefitThreads, 0, stream>>>(tree, mesh, planes, top,
+                                                                   refit_ticket_.data());
+    SNAG_CUDA_CHECK_LAUNCH();
     return;
   }
   launch(refit_leaves_kernel, n, stream, tree, mesh, planes);

@@ -2,9 +2,9 @@
 // the same positions, built, refit and measured with kernels over the shared per-node
 // functions of snag/bvh/tree.h.
 //
-// Memory per triangle n (device): boxes 24 B x (2n - 1); the leaf permutation 4 B; refit
-// counters 4 B per internal node; build scratch, kept between builds: centroids 24 B, three
-// position lists twice (24 B), flags 1 B, scan 12 B, sort keys 16 B: about 150 B per triangle.
+// Memory per triangle n (device): boxes 24 B x (2n - 1); the leaf permutation 4 B; build
+// scratch, kept between builds: centroids 24 B, three position lists twice (24 B), flags 1 B,
+// scan 12 B, sort keys 16 B: about 150 B per triangle.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -61,7 +61,7 @@ class DeviceTree {
   bvh::CompleteTree shape_;
   DeviceBuffer<geom::Box3f> boxes_;
   DeviceBuffer<int32_t> triangle_at_;
-  DeviceBuffer<uint32_t> refit_counters_;
+  DeviceBuffer<unsigned> refit_ticket_;  // subtrees fit; the last block resets it
   // Build scratch.
   DeviceBuffer<geom::Vec3d> centroids_;
   DeviceBuffer<int32_t> lists_, lists_alt_;  // three lists of n triangle ids, axis-major

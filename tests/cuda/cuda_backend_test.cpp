@@ -133,7 +133,9 @@ TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
 
 TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
   SNAG_REQUIRE_GPU();
-  for (int32_t n : {1, 2, 3, 77, 1000, 33333}) {
+  // Up to 2^9 leaves one block fits every level; past 2^18 the levels above the blocks' roots
+  // are wider than a block's buffers (cuda/src/device_tree.cu).
+  for (int32_t n : {1, 2, 3, 77, 257, 512, 513, 1000, 33333, 300001}) {
     SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
     const detect::Topology topology =
         detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
@@ -202,6 +204,35 @@ TEST(CudaDetect, FoldedGridsMatchTheCpuAndBruteForce) {
   }
 }
 
+/// `count` large triangles, each shifted by one along x and y from the last and raised by
+/// `rise` along z: with rise 0 every pair overlaps (coplanar), with rise > 0 none does.
+SmallMesh triangle_stack(int count, double rise) {
+  SmallMesh stack;
+  for (int i = 0; i < count; ++i) {
+    const int32_t base = static_cast<int32_t>(stack.positions.size());
+    const double z = rise * i;
+    stack.positions.push_back({double(i), double(i), z});
+    stack.positions.push_back({1000.0 + i, double(i), z});
+    stack.positions.push_back({double(i), 1000.0 + i, z});
+    stack.triangles.push_back({{base, base + 1, base + 2}});
+  }
+  return stack;
+}
+
+TEST(CudaDetect, ResultsComeBackSortedWhateverTheLastFrameLeftExpected) {
+  SNAG_REQUIRE_GPU();
+  // The results' grid is sized by the last frame's counts: a frame of none, then one of 7,140
+  // pairs (28 slices of the ranking on a grid sized for 4), then none again.
+  const SmallMesh apart = triangle_stack(120, 1.0), together = triangle_stack(120, 0.0);
+  detect::Checker checker(gpu_backend(), std::make_shared<IntegerResolver>());
+  checker.set_triangles(apart.triangles, static_cast<int32_t>(apart.positions.size()));
+  for (const SmallMesh* frame : {&apart, &together, &apart, &together, &together}) {
+    const detect::FrameResult result = checker.check(frame->positions);
+    EXPECT_EQ(result.pairs, brute_force(*frame));
+    EXPECT_EQ(result.pairs.size(), frame == &apart ? 0u : 120u * 119u / 2u);
+  }
+}
+
 TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
   SNAG_REQUIRE_GPU();
   // A folded grid has hundreds of hits and uncertain tests; buffers of 1 and 7 entries must grow.
@@ -209,14 +240,7 @@ TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
   for (int64_t capacity : {1, 7, 100})
     expect_same_filtered(mesh, "capacity " + std::to_string(capacity), capacity);
   // Overlapping coplanar copies: every pair intersects, 44,850 pairs from a 1-entry start.
-  SmallMesh stack;
-  for (int i = 0; i < 300; ++i) {
-    const int32_t base = static_cast<int32_t>(stack.positions.size());
-    stack.positions.push_back({double(i), double(i), 0});
-    stack.positions.push_back({1000.0 + i, double(i), 0});
-    stack.positions.push_back({double(i), 1000.0 + i, 0});
-    stack.triangles.push_back({{base, base + 1, base + 2}});
-  }
+  const SmallMesh stack = triangle_stack(300, 0.0);
   expect_same_filtered(stack, "coplanar stack", 1);
   auto gpu = gpu_backend();
   gpu->set_result_capacity(1);

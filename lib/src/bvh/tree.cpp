@@ -75,9 +75,7 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   // only the box writes scatter, where leaf order would scatter every read.
 #pragma omp parallel for num_threads(threads) schedule(static) if (n > kParallelLevel)
   for (int32_t t = 0; t < n; ++t) {
-    const geom::Tri tri = mesh.triangles[t];
-    tree.boxes[leaf_of_triangle_[t]] = geom::triangle_box(
-        mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
+    tree.boxes[leaf_of_triangle_[t]] = leaf_box(mesh.triangles[t], mesh);
   }
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to
@@ -95,7 +93,8 @@ double Tree::quality(int threads) const {
   const int32_t blocks = quality_block_count(shape_);
   if (blocks == 0) return 0.0;
   std::vector<double> block_sums(static_cast<size_t>(blocks));
-#pragma omp parallel for num_threads(threads) schedule(static) if (blocks > kParallelLevel / kQualityBlock)
+#pragma omp parallel for num_threads(threads) \
+    schedule(static) if (blocks > kParallelLevel / kQualityBlock)
   for (int32_t block = 0; block < blocks; ++block)
     block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
   return quality_from_blocks(block_sums.data(), blocks, boxes_[0]);

@@ -22,11 +22,10 @@ struct TreeView {
   const int32_t* triangle_at = nullptr;  ///< n: the triangle of each leaf position
 };
 
-/// Box of leaf `leaf` from its triangle's current corners.
-SNAG_HD_INLINE void refit_leaf(int32_t leaf, TreeView tree, mesh::MeshView mesh) {
-  const geom::Tri t = mesh.triangles[tree.triangle_at[tree.shape.position_of(leaf)]];
-  tree.boxes[leaf] =
-      geom::triangle_box(mesh.positions[t.v[0]], mesh.positions[t.v[1]], mesh.positions[t.v[2]]);
+/// Box of triangle `tri` from its current corners: its leaf's box, on both backends.
+SNAG_HD_INLINE geom::Box3f leaf_box(const geom::Tri& tri, mesh::MeshView mesh) {
+  return geom::triangle_box(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]],
+                            mesh.positions[tri.v[2]]);
 }
 
 /// Box of internal node `node` from its children's (already refit) boxes.
@@ -172,22 +171,41 @@ SNAG_HD_INLINE void for_each_overlapping_leaf(TreeView tree, const geom::Box3f& 
 }
 
 /// The tree-quality sum in one fixed order that both backends reproduce bit for bit and the
-/// GPU runs in parallel: the internal nodes' half areas summed in blocks of kQualityBlock
-/// consecutive nodes, each block in order; then the block sums in order (quality_from_blocks).
+/// GPU runs in parallel: the internal nodes' half areas in blocks of kQualityBlock consecutive
+/// nodes; in each block, kQualityLanes partial sums, lane k adding the block's nodes k, k +
+/// kQualityLanes, k + 2 kQualityLanes, ... in order, then the partial sums in lane order; then
+/// the block sums in order (quality_from_blocks). The GPU gives a block's lanes to the threads
+/// of one warp: two chains of 32 additions where one sum in node order was a chain of 1024
+/// (10.9 us at 36K triangles, most of the kernel).
 constexpr int32_t kQualityBlock = 1024;
+constexpr int32_t kQualityLanes = 32;
 
 SNAG_HD_INLINE int32_t quality_block_count(const CompleteTree& shape) {
   return (shape.leaf_count - 1 + kQualityBlock - 1) / kQualityBlock;
 }
 
+/// Internal nodes of block `block`: [begin, begin + count).
+SNAG_HD_INLINE int32_t quality_block_size(const CompleteTree& shape, int32_t block) {
+  const int32_t begin = block * kQualityBlock, internal = shape.leaf_count - 1;
+  return begin + kQualityBlock < internal ? kQualityBlock : internal - begin;
+}
+
+/// Lane `lane`'s partial sum of a block of `count` nodes whose k-th half area is area(k).
+template <class Area>
+SNAG_HD_INLINE double quality_lane_sum(Area&& area, int32_t count, int32_t lane) {
+  double sum = 0.0;
+  for (int32_t k = lane; k < count; k += kQualityLanes) sum += area(k);
+  return sum;
+}
+
 /// The sum of block `block`'s internal-node half areas.
 SNAG_HD_INLINE double quality_block_sum(const geom::Box3f* boxes, const CompleteTree& shape,
                                         int32_t block) {
-  const int32_t begin = block * kQualityBlock;
-  const int32_t end =
-      begin + kQualityBlock < shape.leaf_count - 1 ? begin + kQualityBlock : shape.leaf_count - 1;
+  const geom::Box3f* first = boxes + block * kQualityBlock;
+  const int32_t count = quality_block_size(shape, block);
   double sum = 0.0;
-  for (int32_t node = begin; node < end; ++node) sum += geom::half_area(boxes[node]);
+  for (int32_t lane = 0; lane < kQualityLanes; ++lane)
+    sum += quality_lane_sum([&](int32_t k) { return geom::half_area(first[k]); }, count, lane);
   return sum;
 }
 
