@@ -478,7 +478,7 @@ class CudaBackendImpl final : public CudaBackend {
                            grown(c.expanded + c.duplicates), grown(c.listed_most),
                            grown(c.subwalks_most));
     subwalks_expected_ = grown(c.subwalks_most);
-    expand_expected_ = grown(c.hits + c.duplicates);
+    expand_expected_ = grown(2 * c.hits + c.duplicates);
     // Any count fits the ranking's grid (it strides): sized for the last frame's, without slack.
     finish_expected_ = std::max(c.pairs, c.uncertain);
   }
@@ -559,7 +559,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
   uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
-  uint64_t expand_expected_ = 1;     // its hits and duplicates, with slack
+  uint64_t expand_expected_ = 1;     // its expansion's items (two per hit), with slack
   uint64_t finish_expected_ = 1;     // its pairs or uncertain tests, the more
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.

@@ -245,6 +245,10 @@ __global__ void __launch_bounds__(kBlock)
 __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::Vec3d* positions,
                                             const geom::Tri* triangles, const PairSet& set,
                                             FrameCounters* counters) {
+  const int32_t a = static_cast<int32_t>(key >> bits);
+  const int32_t b = static_cast<int32_t>(key & ((1ull << bits) - 1));
+  // Loaded ahead of the probe, whose atomics they would otherwise wait behind.
+  const geom::Tri ta = triangles[a], tb = triangles[b];
   unsigned long long slot = (key * 0x9E3779B97F4A7C15ull) >> 20 & set.table_mask;
   for (;;) {
     const unsigned long long was =
@@ -257,10 +261,8 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
   // serialised them.
   const unsigned long long at = claim_slot(&counters->pairs);
   if (at >= set.pair_capacity) return;  // counted: the host grows the buffers and runs again
-  const int32_t a = static_cast<int32_t>(key >> bits);
-  const int32_t b = static_cast<int32_t>(key & ((1ull << bits) - 1));
   const geom::FilteredPredicates pred{positions};
-  const geom::Answer crossing = geom::is_crossing(pred, triangles[a], triangles[b]);
+  const geom::Answer crossing = geom::is_crossing(pred, ta, tb);
   set.keys[at] = key;
   // bit 0: touching (PairKind's value), bit 1: certain
   set.status[at] = crossing == geom::Answer::uncertain
@@ -268,9 +270,12 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
                        : (crossing == geom::Answer::yes ? uint8_t{2} : uint8_t{3});
 }
 
-/// The hits' pairs and the duplicated faces into the pair set, one item each, hits first; a
-/// fixed grid (launch_counted) strides over the stored items. Past a capacity the narrow phase
-/// counted without storing: the host grows the buffers and runs the frame again.
+/// The hits' pairs and the duplicated faces into the pair set, hits first, two items per hit:
+/// the first of its edge's faces, and the others (one, but for a non-manifold edge), so that a
+/// thread's chain of loads, probe and classification is one pair's, not two in turn; then one
+/// item per duplicated face pair. A fixed grid (launch_counted) strides over the stored items.
+/// Past a capacity the narrow phase counted without storing: the host grows the buffers and
+/// runs the frame again.
 __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capacity,
                               const uint64_t* duplicates, unsigned long long duplicate_capacity,
                               FrameCounters* counters, const int32_t* offsets, const int32_t* faces,
@@ -278,13 +283,16 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
                               const geom::Tri* triangles, PairSet set) {
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
-  const unsigned long long hit_count = min(counters->hits, hit_capacity);
-  const unsigned long long items = hit_count + min(counters->duplicates, duplicate_capacity);
+  const unsigned long long hit_items = 2 * min(counters->hits, hit_capacity);
+  const unsigned long long items = hit_items + min(counters->duplicates, duplicate_capacity);
   for (unsigned long long i = first; i < items; i += stride) {
-    if (i < hit_count) {
-      const int32_t edge = static_cast<int32_t>(hits[i] >> 32);
-      const int32_t triangle = static_cast<int32_t>(hits[i] & 0xffffffffu);
-      for (int32_t j = offsets[edge]; j < offsets[edge + 1]; ++j) {
+    if (i < hit_items) {
+      const uint64_t hit = hits[i >> 1];
+      const int32_t edge = static_cast<int32_t>(hit >> 32);
+      const int32_t triangle = static_cast<int32_t>(hit & 0xffffffffu);
+      const int32_t begin = offsets[edge], end = offsets[edge + 1];
+      const int32_t from = (i & 1) ? begin + 1 : begin, to = (i & 1) ? end : min(begin + 1, end);
+      for (int32_t j = from; j < to; ++j) {
         const int32_t face = faces[j];
         if (face == triangle || degenerate[face]) continue;
         const uint64_t key = (static_cast<uint64_t>(min(face, triangle)) << bits) |
@@ -292,7 +300,7 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
         insert_pair(key, bits, positions, triangles, set, counters);
       }
     } else {
-      const uint64_t d = duplicates[i - hit_count];
+      const uint64_t d = duplicates[i - hit_items];
       insert_pair(((d >> 32) << bits) | (d & 0xffffffffu), bits, positions, triangles, set,
                   counters);
     }
@@ -472,8 +480,8 @@ void launch_expand(const uint64_t* hits, unsigned long long hit_capacity,
                    const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
                    const geom::Tri* triangles, const PairSet& set, unsigned max_blocks,
                    cudaStream_t stream) {
-  launch_counted(expand_kernel, std::min(expected, hit_capacity + duplicate_capacity), max_blocks,
-                 stream, hits, hit_capacity, duplicates, duplicate_capacity, counters,
+  launch_counted(expand_kernel, std::min(expected, 2 * hit_capacity + duplicate_capacity),
+                 max_blocks, stream, hits, hit_capacity, duplicates, duplicate_capacity, counters,
                  edge_face_offsets, edge_faces, degenerate, bits, positions, triangles, set);
 }
 
