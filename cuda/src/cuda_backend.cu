@@ -479,8 +479,14 @@ class CudaBackendImpl final : public CudaBackend {
                            grown(c.subwalks_most));
     subwalks_expected_ = grown(c.subwalks_most);
     expand_expected_ = grown(2 * c.hits + c.duplicates);
-    // Any count fits the ranking's grid (it strides): sized for the last frame's, without slack.
-    finish_expected_ = std::max(c.pairs, c.uncertain);
+    // Any count fits the ranking's grid (it strides), but a grid much too small ranks slowly:
+    // sized for the larger of this frame's count and seven eighths of what it was sized for,
+    // so that a sequence whose frames alternate between many results and none (the 1M cloth's
+    // two bench frames: thousands of uncertain tests, then none) keeps the larger grid, where
+    // one block ranked thousands of keys in turn (0.1 ms), and a single heavy frame is
+    // forgotten within a few dozen.
+    finish_expected_ =
+        std::max<uint64_t>(std::max(c.pairs, c.uncertain), finish_expected_ - finish_expected_ / 8);
   }
 
   /// The frame's degenerate flags and edge ownership on the device.
@@ -560,7 +566,7 @@ class CudaBackendImpl final : public CudaBackend {
                                      // above it to the subwalk kernel
   uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
   uint64_t expand_expected_ = 1;     // its expansion's items (two per hit), with slack
-  uint64_t finish_expected_ = 1;     // its pairs or uncertain tests, the more
+  uint64_t finish_expected_ = 1;     // its pairs or uncertain tests, the more (see fit_counts)
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
   // The pair set (PairSet) and the large-frame path's sort buffers.
   DeviceBuffer<unsigned long long> table_;
@@ -606,7 +612,7 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
 
 /// One run of a frame's checks queued whole, without a wait: planes where no refit or build
 /// computed them, then per check its walk and pair tests, the expansion into the pair set, and
-/// (when the frame's results fit one block) the sort straight into host memory. Buffers are
+/// (up to kFinishLimit results) the ranking straight into host memory. Buffers are
 /// sized by earlier frames; a count past a capacity is counted, not stored (see detect_checks).
 void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_t> checks,
                                    const uint8_t* owned) {

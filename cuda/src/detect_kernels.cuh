@@ -84,8 +84,8 @@ struct HostResults {
 /// finish_kernel ranks at most kFinishLimit pairs (and as many uncertain tests), comparing
 /// every key with every other, kFinishThreads against kFinishThreads per block; frames with
 /// more go through CUB's device-wide sort after the host has read the counts. At 3K pairs the
-/// ranking takes a few microseconds over ~150 blocks, where one block's radix sort (CUB's
-/// BlockRadixSort, 1024 threads) took 20 and did not shorten with other shapes (cuda/NOTES.md).
+/// ranking takes 13 us over ~150 blocks, where one block's radix sort (CUB's BlockRadixSort,
+/// 1024 threads) took 24 and no other shape of it took less than 18 (cuda/NOTES.md, v7).
 inline constexpr int kFinishThreads = 256;
 inline constexpr unsigned kFinishSlices = 32;
 inline constexpr unsigned long long kFinishLimit = kFinishThreads * kFinishSlices;
