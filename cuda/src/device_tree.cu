@@ -173,18 +173,18 @@ __device__ __forceinline__ geom::Box3f load_from_l2(const geom::Box3f* box) {
   return loaded;
 }
 
-__global__ void __launch_bounds__(kRefitThreads)
-    refit_subtrees_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
-                          int32_t top, unsigned* ticket) {
-  __shared__ RefitLevels levels;
-  __shared__ bool last;
-  const CompleteTree& shape = tree.shape;
-  const int32_t nodes = shape.node_count();
-  const int32_t offset = static_cast<int32_t>(blockIdx.x);
-  geom::Box3f* below = levels.narrow;  // unused at the deepest level (all leaves)
-  geom::Box3f* here = levels.wide;
-  for (int32_t level = shape.depth; level >= top; --level) {
-    const int32_t width = 1 << (level - top);
+/// Fits levels `deepest` up to `root_level` (inclusive) of the subtree under node `offset` of
+/// `root_level`, one level at a time with a block barrier after each: every box goes to
+/// tree.boxes and to `here`, which serves as the next level's `below` (the two swap). `below`
+/// holds the boxes of the level under `deepest` when that level's nodes are internal. No level
+/// of the subtree is wider than the buffer it goes to (RefitLevels).
+__device__ void fit_subtree_levels(const bvh::TreeView& tree, const mesh::MeshView& mesh,
+                                   geom::PlaneCoefficients* planes, int32_t root_level,
+                                   int32_t offset, int32_t deepest, geom::Box3f* below,
+                                   geom::Box3f* here) {
+  const int32_t nodes = tree.shape.node_count();
+  for (int32_t level = deepest; level >= root_level; --level) {
+    const int32_t width = 1 << (level - root_level);
     const int32_t first = CompleteTree::level_begin(level) + offset * width;
     for (int32_t j = static_cast<int32_t>(threadIdx.x); j < width; j += kRefitThreads) {
       const int32_t node = first + j;
@@ -194,9 +194,20 @@ __global__ void __launch_bounds__(kRefitThreads)
       here[j] = box;
     }
     __syncthreads();
-    below = here;
-    here = here == levels.wide ? levels.narrow : levels.wide;
+    geom::Box3f* const filled = here;
+    here = below;
+    below = filled;
   }
+}
+
+__global__ void __launch_bounds__(kRefitThreads)
+    refit_subtrees_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
+                          int32_t top, unsigned* ticket) {
+  __shared__ RefitLevels levels;
+  __shared__ bool last;
+  // The block's subtree: its deepest level (all leaves) needs no `below`.
+  fit_subtree_levels(tree, mesh, planes, top, static_cast<int32_t>(blockIdx.x), tree.shape.depth,
+                     levels.narrow, levels.wide);
   if (top == 0) return;
 
   // The levels above: the last block, once every block's root is stored.
@@ -218,23 +229,10 @@ __global__ void __launch_bounds__(kRefitThreads)
     }
     __syncthreads();
   }
-  below = levels.wide;
-  here = levels.narrow;
   for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << level); j += kRefitThreads)
-    below[j] = load_from_l2(tree.boxes + CompleteTree::level_begin(level) + j);
+    levels.wide[j] = load_from_l2(tree.boxes + CompleteTree::level_begin(level) + j);
   __syncthreads();
-  for (--level; level >= 0; --level) {
-    const int32_t first = CompleteTree::level_begin(level);
-    for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << level); j += kRefitThreads) {
-      const geom::Box3f box = geom::merge(below[2 * j], below[2 * j + 1]);
-      tree.boxes[first + j] = box;
-      here[j] = box;
-    }
-    __syncthreads();
-    geom::Box3f* const filled = here;
-    here = below;
-    below = filled;
-  }
+  fit_subtree_levels(tree, mesh, planes, 0, 0, level - 1, levels.wide, levels.narrow);
 }
 
 /// The quality in one launch, one CUDA block per block of bvh::kQualityBlock internal nodes:
