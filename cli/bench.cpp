@@ -20,6 +20,7 @@
 #include "bench_support.h"
 #include "commands.h"
 #include "snag/detect/checker.h"
+#include "snag/detect/cpu_backend.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
@@ -46,6 +47,12 @@ struct Row {
   std::string note;
 };
 
+detect::CpuWalkWidth walk_width(int lanes) {
+  return lanes == 4   ? detect::CpuWalkWidth::four
+         : lanes == 8 ? detect::CpuWalkWidth::eight
+                      : detect::CpuWalkWidth::automatic;
+}
+
 Row run_case(const BenchCase& c, const BenchOptions& o) {
   const CaseFrames read = read_case(c, "snag bench");
   const std::vector<mesh::Mesh>& meshes = read.meshes;
@@ -60,9 +67,10 @@ Row run_case(const BenchCase& c, const BenchOptions& o) {
   // Two checkers over the same frames: one refits (the steady state of a sequence), one
   // rebuilds every frame (the build time per frame).
   auto resolver = validators::make_cgal_resolver();
-  detect::Checker refitting(make_backend("cpu", o.threads), resolver,
+  const detect::CpuWalkWidth width = walk_width(o.walk_lanes);
+  detect::Checker refitting(detect::make_cpu_backend(o.threads, width), resolver,
                             {detect::RebuildPolicy::never});
-  detect::Checker rebuilding(make_backend("cpu", o.threads), resolver,
+  detect::Checker rebuilding(detect::make_cpu_backend(o.threads, width), resolver,
                              {detect::RebuildPolicy::always});
   refitting.set_triangles(first.triangles, vertices);
   rebuilding.set_triangles(first.triangles, vertices);
@@ -107,9 +115,11 @@ Row run_case(const BenchCase& c, const BenchOptions& o) {
   return row;
 }
 
-void print_table(const std::vector<Row>& rows, int threads) {
-  std::printf("snag bench cpu: %d threads; medians over the timed frames, milliseconds per frame\n",
-              threads);
+void print_table(const std::vector<Row>& rows, int threads, int lanes) {
+  std::printf(
+      "snag bench cpu: %d threads, walks of %d leaves; medians over the timed frames, "
+      "milliseconds per frame\n",
+      threads, lanes);
   std::printf(
       "snag total = refit + traverse + exact/classify (the tree is built once per topology; build "
       "is\n"
@@ -148,6 +158,12 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
       ->type_name("N")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cpu->add_option("--walk-lanes", o.walk_lanes,
+                  "Leaves that walk the tree together: 4, 8 (needs AVX2 to be fast), or 0 for "
+                  "8 where the CPU has AVX2, else 4")
+      ->type_name("N")
+      ->check(CLI::IsMember({0, 4, 8}))
+      ->capture_default_str();
   return cpu;
 }
 
@@ -171,7 +187,8 @@ int run_bench_cpu(const BenchOptions& o) {
 
   std::vector<Row> rows;
   for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
-  print_table(rows, o.threads > 0 ? o.threads : omp_get_max_threads());
+  print_table(rows, o.threads > 0 ? o.threads : omp_get_max_threads(),
+              detect::cpu_walk_lanes(walk_width(o.walk_lanes)));
   const bool all_same = std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; });
   if (!all_same) throw InternalError("snag and CGAL found different pairs (see the table)");
   return 0;

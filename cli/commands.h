@@ -43,6 +43,7 @@ struct BenchOptions {
   std::vector<std::string> inputs;
   std::string generator;
   int threads = 0;
+  int walk_lanes = 0;  ///< leaves per walk on the CPU: 4, 8, or 0 for the machine's choice
 };
 
 /// Adds `bench` and its `cpu` subcommand; returns the `cpu` subcommand.

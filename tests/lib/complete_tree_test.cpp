@@ -7,6 +7,7 @@
 #include <set>
 
 #include "snag/bvh/complete_tree.h"
+#include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
 
 namespace snag::bvh {
@@ -173,14 +174,14 @@ PairMultiset per_leaf_pairs(const TreeView& view) {
   return pairs;
 }
 
-/// Every pair the grouped walk visits over all groups, likewise.
+/// Every pair the grouped walk (groups of W leaves) visits over all groups, likewise.
+template <int W>
 PairMultiset grouped_pairs(const TreeView& view) {
   PairMultiset pairs;
-  const int32_t level = group_level(view.shape);
-  const int32_t first = CompleteTree::level_begin(level);
-  const int32_t last = std::min(CompleteTree::level_begin(level + 1), view.shape.node_count());
+  int32_t first, last;
+  group_range<W>(view.shape, first, last);
   for (int32_t group = first; group < last; ++group)
-    for_each_later_overlap_grouped(view, group, [&](int32_t t, int32_t x) {
+    for_each_later_overlap_grouped<W>(view, group, [&](int32_t t, int32_t x) {
       pairs.insert({std::min(t, x), std::max(t, x)});
     });
   return pairs;
@@ -329,7 +330,7 @@ TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
 TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
   // Coordinates past FLT_MAX (finite doubles) give leaf boxes of +-FLT_MAX or infinity, which
   // also "overlap" an empty box: lanes without a member must still never be visited.
-  for (int32_t n : {2, 3, 5, 6, 7, 11}) {
+  for (int32_t n : {2, 3, 5, 6, 7, 11, 13, 17}) {
     Soup soup;
     for (int32_t t = 0; t < n; ++t) {
       const double s = 4e38 + t * 1e37;
@@ -341,16 +342,18 @@ TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
     Tree tree;
     tree.build(soup.view(), 1);
     const TreeView view = tree.view();
-    const PairMultiset per_leaf = per_leaf_pairs(view), grouped = grouped_pairs(view);
-    // Pairs are (smaller, larger): an absent lane's id -1 would come first.
-    ASSERT_TRUE(grouped.empty() || grouped.begin()->first >= 0) << "n=" << n;
-    EXPECT_EQ(grouped, per_leaf) << "n=" << n;
+    const PairMultiset per_leaf = per_leaf_pairs(view);
+    for (const PairMultiset& grouped : {grouped_pairs<4>(view), grouped_pairs<8>(view)}) {
+      // Pairs are (smaller, larger): an absent lane's id -1 would come first.
+      ASSERT_TRUE(grouped.empty() || grouped.begin()->first >= 0) << "n=" << n;
+      EXPECT_EQ(grouped, per_leaf) << "n=" << n;
+    }
     EXPECT_EQ(per_leaf.size(), static_cast<size_t>(n * (n - 1) / 2)) << "n=" << n;
   }
 }
 
 TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
-  for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 31, 100, 513, 2000}) {
+  for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 100, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {
       const uint32_t seed = static_cast<uint32_t>(n * 17 + size * 3);
       SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
@@ -359,8 +362,9 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
       Tree tree;
       tree.build(soup.view(), 2);
       const TreeView view = tree.view();
-      const PairMultiset per_leaf = per_leaf_pairs(view), grouped = grouped_pairs(view);
-      ASSERT_EQ(grouped, per_leaf);
+      const PairMultiset per_leaf = per_leaf_pairs(view);
+      ASSERT_EQ(grouped_pairs<4>(view), per_leaf);
+      ASSERT_EQ(grouped_pairs<8>(view), per_leaf);
     }
   }
 }

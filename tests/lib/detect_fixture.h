@@ -15,10 +15,11 @@ struct SmallMesh {
   std::vector<geom::Tri> triangles;
 };
 
-inline detect::FrameResult check_mesh(const SmallMesh& mesh, int threads = 2,
-                                      std::shared_ptr<detect::ExactResolver> resolver = nullptr) {
+inline detect::FrameResult check_mesh(
+    const SmallMesh& mesh, int threads = 2, std::shared_ptr<detect::ExactResolver> resolver = nullptr,
+    detect::CpuWalkWidth width = detect::CpuWalkWidth::automatic) {
   if (!resolver) resolver = std::make_shared<IntegerResolver>();
-  detect::Checker checker(detect::make_cpu_backend(threads), resolver);
+  detect::Checker checker(detect::make_cpu_backend(threads, width), resolver);
   checker.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
   return checker.check(mesh.positions);
 }

@@ -34,6 +34,24 @@ TEST(Detect, MatchesBruteForceOnFoldedGrids) {
   }
 }
 
+TEST(Detect, BothWalkWidthsMatchBruteForce) {
+  // Groups of 4 and of 8 leaves (the width a CPU with AVX2 runs; without AVX2 the 8-lane code
+  // runs unaccelerated here), on soups with and without welded-out vertices alike.
+  SCOPED_TRACE("this machine walks groups of " + std::to_string(detect::cpu_walk_lanes()));
+  for (uint32_t seed = 1; seed <= 12; ++seed) {
+    const int32_t n = 5 + static_cast<int32_t>(seed * 13 % 120);
+    const SmallMesh mesh = lattice_soup(n, 2 * n, 3 + static_cast<int>(seed % 4), seed);
+    const std::vector<detect::FacePair> expected = brute_force(mesh);
+    for (auto width : {detect::CpuWalkWidth::four, detect::CpuWalkWidth::eight})
+      for (int threads : {1, 2})
+        ASSERT_EQ(check_mesh(mesh, threads, nullptr, width).pairs, expected)
+            << "seed " << seed << " lanes " << detect::cpu_walk_lanes(width);
+  }
+  const SmallMesh grid = folded_grid(17, 9);
+  for (auto width : {detect::CpuWalkWidth::four, detect::CpuWalkWidth::eight})
+    EXPECT_EQ(check_mesh(grid, 2, nullptr, width).pairs, brute_force(grid));
+}
+
 TEST(Detect, RefitMatchesRebuildAndBruteForceAfterDeformation) {
   SmallMesh mesh = folded_grid(15, 10);
   auto resolver = std::make_shared<IntegerResolver>();
@@ -114,7 +132,9 @@ TEST(Detect, FansAboveTheListedValenceAreFoundByTheTraversal) {
   const std::vector<detect::FacePair> expected = brute_force(mesh);
   ASSERT_GT(expected.size(), 20u);
   for (int threads : {1, 2})
-    EXPECT_EQ(check_mesh(mesh, threads).pairs, expected) << threads << " threads";
+    for (auto width : {detect::CpuWalkWidth::four, detect::CpuWalkWidth::eight})
+      EXPECT_EQ(check_mesh(mesh, threads, nullptr, width).pairs, expected)
+          << threads << " threads, lanes " << detect::cpu_walk_lanes(width);
 }
 
 TEST(Detect, EmptyAndSingleTriangleMeshes) {

@@ -12,8 +12,9 @@
 namespace snag::test {
 namespace {
 
-std::unique_ptr<detect::Checker> make_checker(int threads) {
-  return std::make_unique<detect::Checker>(detect::make_cpu_backend(threads),
+std::unique_ptr<detect::Checker> make_checker(
+    int threads, detect::CpuWalkWidth width = detect::CpuWalkWidth::automatic) {
+  return std::make_unique<detect::Checker>(detect::make_cpu_backend(threads, width),
                                            std::make_shared<IntegerResolver>());
 }
 
@@ -34,7 +35,10 @@ TEST(SceneCheck, PairsAreTheBruteForcePairsOfTheChecksAsked) {
     const Laid laid = lay_end_to_end(parts);
     for (const auto& checks : check_sets)
       for (int threads : {1, 3}) {
-        auto checker = make_checker(threads);
+        // Both walk widths, alternately (groups of 4 and 8 leaves, within and between parts).
+        const auto width = (seed + threads) % 2 ? detect::CpuWalkWidth::four
+                                                : detect::CpuWalkWidth::eight;
+        auto checker = make_checker(threads, width);
         checker->set_scene(laid.mesh.triangles, static_cast<int32_t>(laid.mesh.positions.size()),
                            laid.layout, checks);
         const detect::FrameResult result = checker->check(laid.mesh.positions);

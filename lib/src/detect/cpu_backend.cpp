@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <type_traits>
 
+#include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
 #include "snag/detect/pair_test.h"
 #include "snag/detect/pairs.h"
@@ -35,28 +37,126 @@ struct ThreadSink {
   }
 };
 
-/// The corners' vertex ids of a group's (up to four) lanes, one vector per corner (-1 in
-/// absent lanes), to find in one pass which lanes share a vertex with a triangle.
+/// The corners' vertex ids of a group's (up to W) lanes, one vector per corner (-1 in absent
+/// lanes), to find in one pass which lanes share a vertex with a triangle.
+template <int W>
 struct LaneCorners {
-  bvh::LeafLanes::Mask v[3];
+  typename bvh::LeafLanes<W>::Mask v[3];
 
-  LaneCorners(const bvh::LeafLanes& lanes, const geom::Tri* triangles) {
-    for (int k = 0; k < 3; ++k) v[k] = bvh::LeafLanes::Mask{-1, -1, -1, -1};
-    for (int lane = 0; lane < lanes.members; ++lane)
-      for (int k = 0; k < 3; ++k) v[k][lane] = triangles[lanes.triangle[lane]].v[k];
+  LaneCorners(const bvh::LeafLanes<W>& lanes, const geom::Tri* triangles) {
+    for (int lane = 0; lane < W; ++lane)
+      for (int k = 0; k < 3; ++k)
+        v[k][lane] = lane < lanes.members ? triangles[lanes.triangle[lane]].v[k] : -1;
   }
 
   /// A bit per lane whose triangle has a vertex of `x`.
   uint32_t sharing(const geom::Tri& x) const {
-    bvh::LeafLanes::Mask any{};
+    typename bvh::LeafLanes<W>::Mask any{};
     for (int k = 0; k < 3; ++k) any |= (v[0] == x.v[k]) | (v[1] == x.v[k]) | (v[2] == x.v[k]);
-    return bvh::LeafLanes::bits(any);
+    return bvh::LeafLanes<W>::bits(any);
   }
 };
 
+/// Of the lanes in `sharing` (those sharing a vertex with xt), the ones whose shared vertices
+/// include a listed one: their pairs with xt are in the neighbour list.
+template <int W>
+uint32_t listed_among(uint32_t sharing, const bvh::LeafLanes<W>& lanes, int32_t base,
+                      const geom::Tri& xt, const TopologyView& view) {
+  uint32_t listed = 0;
+  for (uint32_t bits = sharing; bits; bits &= bits - 1) {
+    const int lane = bvh::count_trailing_zeros(bits);
+    if (is_listed_neighbor(view.triangles[base + lanes.triangle[lane]], xt, view.listed_vertex,
+                           false))
+      listed |= 1u << lane;
+  }
+  return listed;
+}
+
+/// What a check's walks read: the tree walked (the whole part for a self check, the larger part
+/// of two), where its triangle ids start, and for two parts the other part's tree and base.
+struct WalkInput {
+  bvh::TreeView tree;
+  int32_t base = 0;
+  bvh::TreeView other;
+  int32_t other_base = 0;
+  const FrameView* frame = nullptr;
+  const TopologyView* view = nullptr;
+  const uint8_t* degenerate = nullptr;
+};
+
+/// The later leaves of a self check for the leaves under node `group` (LeafLanes::for_each_later).
+/// At each leaf the walk reaches, the lanes that share a vertex with it are found together;
+/// when every vertex is listed (no weld left some out) they are dropped at once, else lane by
+/// lane (listed_among).
+template <int W, FilterUse use>
+inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
+  const TopologyView& view = *in.view;
+  const bvh::LeafLanes<W> lanes(in.tree, group);
+  const LaneCorners<W> corners(lanes, view.triangles + in.base);
+  lanes.for_each_later(in.tree, group, [&](uint32_t overlapping, int32_t local_x) {
+    const int32_t x = in.base + local_x;
+    const geom::Tri xt = view.triangles[x];
+    uint32_t sharing = corners.sharing(xt);
+    // Most overlapping leaves are listed neighbours of every lane they overlap (94% of the
+    // overlaps of a settled 36K cloth frame): they end here, after a few compares.
+    if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, in.base, xt, view);
+    uint32_t todo = overlapping & ~sharing;
+    if (todo && in.degenerate[x]) return;
+    for (; todo; todo &= todo - 1) {
+      const int32_t t = in.base + lanes.triangle[bvh::count_trailing_zeros(todo)];
+      if (in.degenerate[t]) continue;
+      ++sink.candidates;
+      test_candidate_pair<use>(*in.frame, view, t, x, sink);
+    }
+  });
+}
+
+/// The leaves under node `group` of in.tree against every leaf of in.other (two parts share no
+/// vertex: every overlap is a candidate).
+template <int W, FilterUse use>
+inline void walk_between_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
+  bvh::for_each_overlap_grouped<W>(in.tree, group, in.other, [&](int32_t local_t, int32_t local_x) {
+    const int32_t t = in.base + local_t, x = in.other_base + local_x;
+    if (in.degenerate[t] || in.degenerate[x]) return;
+    ++sink.candidates;
+    test_candidate_pair<use>(*in.frame, *in.view, t, x, sink);
+  });
+}
+
+// Groups of eight, compiled for AVX2 and called only where the CPU has it. Everything a group
+// walk calls is inlined here (flatten), so that the 32-byte vectors of LeafLanes<8> are single
+// AVX instructions and nothing compiled for AVX2 is shared with the rest of the program. AVX2
+// brings no fused multiply-add (and -ffp-contract=off forbids contracting): the predicates
+// round as everywhere else.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SNAG_HAVE_AVX2_WALK 1
+template <FilterUse use>
+[[gnu::target("avx2"), gnu::flatten]] void walk_self_group_avx2(const WalkInput& in,
+                                                                 int32_t group, ThreadSink& sink) {
+  walk_self_group<8, use>(in, group, sink);
+}
+template <FilterUse use>
+[[gnu::target("avx2"), gnu::flatten]] void walk_between_group_avx2(const WalkInput& in,
+                                                                    int32_t group,
+                                                                    ThreadSink& sink) {
+  walk_between_group<8, use>(in, group, sink);
+}
+#endif
+
+bool cpu_has_avx2() {
+#if defined(SNAG_HAVE_AVX2_WALK)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
 class CpuBackend final : public Backend {
  public:
-  explicit CpuBackend(int threads) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+  CpuBackend(int threads, CpuWalkWidth width)
+      : threads_(threads > 0 ? threads : omp_get_max_threads()),
+        wide_(cpu_walk_lanes(width) == 8),
+        avx2_(cpu_has_avx2()) {}
 
   std::string_view name() const override { return "cpu"; }
 
@@ -197,19 +297,17 @@ class CpuBackend final : public Backend {
   }
 
   /// A part against itself: its neighbour pairs from their list (their boxes always overlap),
-  /// then the other candidates from its tree. The leaves of each group of up to four
-  /// consecutive positions walk the tree together (LeafLanes::for_each_later), groups in leaf
-  /// order; dynamic chunks because groups in dense regions cost more. At each leaf the walk
-  /// reaches, the lanes that share a vertex with it are found together; when every vertex is
-  /// listed (no weld left some out) they are dropped at once, else lane by lane
-  /// (listed_among).
+  /// then the other candidates from its tree, the leaves in groups of 4 or 8 consecutive
+  /// positions (walk_self_group), groups in leaf order; dynamic chunks because groups in dense
+  /// regions cost more.
   template <FilterUse use>
   void detect_self(int32_t part, const FrameView& frame_view, const TopologyView& view,
                    const std::vector<uint8_t>& degenerate_flags, std::vector<ThreadSink>& sinks) {
     const Topology& topo = *topology_;
     const int32_t base = topo.layout.triangle_begin[part];
     if (topo.layout.triangle_begin[part + 1] == base) return;
-    const bvh::TreeView tree = trees_[part].view();
+    const WalkInput in{trees_[part].view(), base, {}, 0, &frame_view, &view,
+                       degenerate_flags.data()};
     const int64_t neighbor_begin = topo.self_neighbors[2 * part];
     const int64_t neighbor_end = topo.self_neighbors[2 * part + 1];
 #pragma omp parallel num_threads(threads_)
@@ -223,49 +321,21 @@ class CpuBackend final : public Backend {
         const uint32_t shared = topo.neighbor_shared[i];
         test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
       }
-      int32_t first_group, last_group;
-      bvh::group_range(tree.shape, first_group, last_group);
-#pragma omp for schedule(dynamic, 64)
-      for (int32_t group = first_group; group < last_group; ++group) {
-        const bvh::LeafLanes lanes(tree, group);
-        const LaneCorners corners(lanes, view.triangles + base);
-        lanes.for_each_later(tree, group, [&](uint32_t overlapping, int32_t local_x) {
-          const int32_t x = base + local_x;
-          const geom::Tri xt = view.triangles[x];
-          uint32_t sharing = corners.sharing(xt);
-          // Most overlapping leaves are listed neighbours of every lane they overlap (94% of
-          // the overlaps of a settled 36K cloth frame): they end here, after a few compares.
-          if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, base, xt, view);
-          uint32_t todo = overlapping & ~sharing;
-          if (todo && degenerate_flags[x]) return;
-          for (; todo; todo &= todo - 1) {
-            const int32_t t = base + lanes.triangle[bvh::count_trailing_zeros(todo)];
-            if (degenerate_flags[t]) continue;
-            ++sink.candidates;
-            test_candidate_pair<use>(frame_view, view, t, x, sink);
-          }
-        });
-      }
+      for_each_group(in.tree, [&](auto lanes, int32_t group) {
+        if constexpr (decltype(lanes)::value == 4) {
+          walk_self_group<4, use>(in, group, sink);
+        } else {
+#if defined(SNAG_HAVE_AVX2_WALK)
+          if (avx2_) return walk_self_group_avx2<use>(in, group, sink);
+#endif
+          walk_self_group<8, use>(in, group, sink);
+        }
+      });
     }
   }
 
-  /// Of the lanes in `sharing` (those sharing a vertex with xt), the ones whose shared
-  /// vertices include a listed one: their pairs with xt are in the neighbour list.
-  static uint32_t listed_among(uint32_t sharing, const bvh::LeafLanes& lanes, int32_t base,
-                               const geom::Tri& xt, const TopologyView& view) {
-    uint32_t listed = 0;
-    for (uint32_t bits = sharing; bits; bits &= bits - 1) {
-      const int lane = bvh::count_trailing_zeros(bits);
-      if (is_listed_neighbor(view.triangles[base + lanes.triangle[lane]], xt, view.listed_vertex,
-                             false))
-        listed |= 1u << lane;
-    }
-    return listed;
-  }
-
-  /// Two parts: the leaves of the larger one, in groups of up to four, each walk the other's
-  /// whole tree (for_each_overlap_grouped). The parts share no vertex, so there is no
-  /// neighbour list.
+  /// Two parts: the leaves of the larger one, in groups, each walk the other's whole tree
+  /// (walk_between_group). The parts share no vertex, so there is no neighbour list.
   template <FilterUse use>
   void detect_between(int32_t a, int32_t b, const FrameView& frame_view, const TopologyView& view,
                       const std::vector<uint8_t>& degenerate_flags,
@@ -276,22 +346,41 @@ class CpuBackend final : public Backend {
     };
     if (size(a) == 0 || size(b) == 0) return;
     if (size(a) < size(b)) std::swap(a, b);
-    const int32_t base_a = topo.layout.triangle_begin[a], base_b = topo.layout.triangle_begin[b];
-    const bvh::TreeView tree = trees_[a].view(), other = trees_[b].view();
-    int32_t first_group, last_group;
-    bvh::group_range(tree.shape, first_group, last_group);
+    const WalkInput in{trees_[a].view(),     topo.layout.triangle_begin[a],
+                       trees_[b].view(),     topo.layout.triangle_begin[b],
+                       &frame_view,          &view,
+                       degenerate_flags.data()};
 #pragma omp parallel num_threads(threads_)
     {
       ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
+      for_each_group(in.tree, [&](auto lanes, int32_t group) {
+        if constexpr (decltype(lanes)::value == 4) {
+          walk_between_group<4, use>(in, group, sink);
+        } else {
+#if defined(SNAG_HAVE_AVX2_WALK)
+          if (avx2_) return walk_between_group_avx2<use>(in, group, sink);
+#endif
+          walk_between_group<8, use>(in, group, sink);
+        }
+      });
+    }
+  }
+
+  /// Inside a parallel region: walk(width, group) for every group of the chosen width
+  /// (std::integral_constant 4 or 8), shared among the threads in dynamic chunks of 256 leaves.
+  template <class Walk>
+  void for_each_group(const bvh::TreeView& tree, Walk&& walk) const {
+    int32_t first_group, last_group;
+    if (wide_) {
+      bvh::group_range<8>(tree.shape, first_group, last_group);
+#pragma omp for schedule(dynamic, 32)
+      for (int32_t group = first_group; group < last_group; ++group)
+        walk(std::integral_constant<int, 8>{}, group);
+    } else {
+      bvh::group_range<4>(tree.shape, first_group, last_group);
 #pragma omp for schedule(dynamic, 64)
-      for (int32_t group = first_group; group < last_group; ++group) {
-        bvh::for_each_overlap_grouped(tree, group, other, [&](int32_t local_t, int32_t local_x) {
-          const int32_t t = base_a + local_t, x = base_b + local_x;
-          if (degenerate_flags[t] || degenerate_flags[x]) return;
-          ++sink.candidates;
-          test_candidate_pair<use>(frame_view, view, t, x, sink);
-        });
-      }
+      for (int32_t group = first_group; group < last_group; ++group)
+        walk(std::integral_constant<int, 4>{}, group);
     }
   }
 
@@ -304,6 +393,8 @@ class CpuBackend final : public Backend {
   }
 
   int threads_;
+  bool wide_;  ///< groups of 8 leaves, else 4
+  bool avx2_;  ///< the CPU has AVX2: groups of 8 run walk_*_group_avx2
   const Topology* topology_ = nullptr;
   std::span<const geom::Vec3d> positions_;
   std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
@@ -312,8 +403,20 @@ class CpuBackend final : public Backend {
 
 }  // namespace
 
-std::unique_ptr<Backend> make_cpu_backend(int threads) {
-  return std::make_unique<CpuBackend>(threads);
+int cpu_walk_lanes(CpuWalkWidth width) {
+  switch (width) {
+    case CpuWalkWidth::four:
+      return 4;
+    case CpuWalkWidth::eight:
+      return 8;
+    case CpuWalkWidth::automatic:
+      break;
+  }
+  return cpu_has_avx2() ? 8 : 4;
+}
+
+std::unique_ptr<Backend> make_cpu_backend(int threads, CpuWalkWidth width) {
+  return std::make_unique<CpuBackend>(threads, width);
 }
 
 }  // namespace snag::detect

@@ -4,7 +4,6 @@
 // inverse): about 52 (56) bytes per triangle.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -217,131 +216,6 @@ SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t bloc
   for (int32_t block = 0; block < blocks; ++block) sum += block_sums[block];
   const double root_area = geom::half_area(root);
   return blocks > 0 && root_area > 0.0 ? sum / root_area : 0.0;
-}
-
-/// The level whose nodes group leaves for for_each_later_overlap_grouped: D - 2, where every
-/// node is internal and holds 2 to 4 leaves (those of levels D - 1 and D below it).
-inline int32_t group_level(const CompleteTree& shape) {
-  return shape.depth >= 2 ? shape.depth - 2 : 0;
-}
-
-/// The nodes of group_level(): [first, last), in leaf order.
-inline void group_range(const CompleteTree& shape, int32_t& first, int32_t& last) {
-  const int32_t level = group_level(shape);
-  first = CompleteTree::level_begin(level);
-  last = std::min(CompleteTree::level_begin(level + 1), shape.node_count());
-}
-
-/// The (up to four) leaves under node `group` of group_level() as SIMD lanes: their boxes and
-/// triangles, for walks that test every node against all of them at once (4-lane compares, as a
-/// GPU warp runs its leaves together). Absent lanes get an empty box and are masked out.
-struct LeafLanes {
-  typedef float Lanes __attribute__((vector_size(16)));
-  typedef int32_t Mask __attribute__((vector_size(16)));
-  Lanes lo[3], hi[3];
-  Mask present;
-  int32_t triangle[4] = {-1, -1, -1, -1};
-  int32_t leaf[4] = {-1, -1, -1, -1};
-  int32_t members = 0;  ///< 2..4 (1 when the whole tree is one leaf)
-
-  LeafLanes(const TreeView& tree, int32_t group) {
-    int32_t begin, end;
-    tree.shape.positions_under(group, begin, end);
-    members = end - begin;
-    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = Lanes{};
-    for (int lane = 0; lane < 4; ++lane) {
-      geom::Box3f box = geom::empty_box();
-      if (lane < members) {
-        leaf[lane] = tree.shape.leaf_at(begin + lane);
-        box = tree.boxes[leaf[lane]];
-        triangle[lane] = tree.triangle_at[begin + lane];
-      }
-      for (int k = 0; k < 3; ++k) {
-        lo[k][lane] = box.lo[k];
-        hi[k][lane] = box.hi[k];
-      }
-    }
-    // The empty box is not enough: a leaf box that reaches +-FLT_MAX on every axis
-    // (coordinates beyond the float range) overlaps it.
-    present = Mask{members > 0 ? -1 : 0, members > 1 ? -1 : 0, members > 2 ? -1 : 0,
-                   members > 3 ? -1 : 0};
-  }
-
-  Mask overlaps(const geom::Box3f& box) const {
-    return (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
-           (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) & present;
-  }
-
-  /// Bit `lane` of the result set for each lane whose bit is set in `mask`.
-  static uint32_t bits(Mask mask) {
-    return static_cast<uint32_t>((mask[0] & 1) | (mask[1] & 2) | (mask[2] & 4) | (mask[3] & 8));
-  }
-
-  /// Walks `tree`'s subtree under `root` for all lanes at once, descending where any lane
-  /// overlaps; at a leaf, calls visit_leaf(lane_bits, leaf's triangle) with a bit per lane
-  /// that overlaps it (at least one).
-  template <class VisitLeaf>
-  void walk_leaves(const TreeView& tree, int32_t root, VisitLeaf&& visit_leaf) const {
-    Mask last{};
-    walk_subtree(
-        tree, root,
-        [&](int32_t i) {
-          last = overlaps(tree.boxes[i]);
-          return (last[0] | last[1] | last[2] | last[3]) != 0;
-        },
-        [&](int32_t i) { visit_leaf(bits(last), tree.triangle_at[tree.shape.position_of(i)]); });
-  }
-
-  /// A visit_leaf for walk_leaves and for_each_later that calls visit(lane triangle, leaf's
-  /// triangle) for each lane in its bits.
-  template <class Visit>
-  auto each_lane(Visit& visit) const {
-    return [this, &visit](uint32_t lanes, int32_t other) {
-      for (; lanes; lanes &= lanes - 1) visit(triangle[count_trailing_zeros(lanes)], other);
-    };
-  }
-
-  /// walk_leaves, calling visit(lane triangle, leaf's triangle) for each overlapping lane.
-  template <class Visit>
-  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
-    walk_leaves(tree, root, each_lane(visit));
-  }
-
-  /// The query of for_each_later_overlap for every member at once (this group's node is
-  /// `group`): calls visit_leaf(lane_bits, other_triangle) for every later leaf, with a bit for
-  /// each member whose box overlaps it, so that each unordered pair is visited once. Pairs of
-  /// members come first, as (bit of the earlier member, later member's triangle).
-  template <class VisitLeaf>
-  void for_each_later(const TreeView& tree, int32_t group, VisitLeaf&& visit_leaf) const {
-    for (int a = 0; a < members; ++a)
-      for (int b = a + 1; b < members; ++b)
-        if (geom::overlap(tree.boxes[leaf[a]], tree.boxes[leaf[b]]))
-          visit_leaf(1u << a, triangle[b]);
-    // Members against the later subtrees: the right siblings of the group's left-child
-    // ancestors.
-    for (int32_t node = group; node > 0; node = (node - 1) >> 1)
-      if (node & 1) walk_leaves(tree, node + 1, visit_leaf);
-  }
-};
-
-/// The per-leaf query of for_each_later_overlap, run for the (up to four) leaves under node
-/// `group` of group_level() at once: calls visit(member_triangle, other_triangle) for every
-/// pair of a member and a later leaf whose boxes overlap, each unordered pair once. The
-/// members share every ancestor above the group, so their walks through the later subtrees
-/// are one walk (LeafLanes::for_each_later). Memory: a few registers and the four boxes.
-template <class Visit>
-inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
-  const LeafLanes lanes(tree, group);
-  lanes.for_each_later(tree, group, lanes.each_lane(visit));
-}
-
-/// for_each_overlap for the (up to four) leaves under node `group` of `tree` (group_level())
-/// against every leaf of `other`: calls visit(member_triangle, other_triangle) for every pair
-/// whose boxes overlap.
-template <class Visit>
-inline void for_each_overlap_grouped(TreeView tree, int32_t group, TreeView other, Visit&& visit) {
-  const LeafLanes lanes(tree, group);
-  lanes.walk(other, 0, visit);
 }
 
 /// Owning tree on the host (the CPU backend; the CUDA backend keeps device buffers instead).

@@ -1,0 +1,188 @@
+// The CPU's walks over the tree (tree.h) in groups: the W consecutive leaves under one node near
+// the bottom of the tree walk it together, one SIMD lane each, as a GPU warp runs its leaves
+// together. A step tests one node's box against every lane's box at once, so a group's walk
+// costs about what one leaf's walk does while it finds the overlaps of W leaves.
+//
+// W is 4 (16-byte vectors, every x86-64 CPU) or 8 (32-byte vectors: one AVX instruction per
+// compare when the caller is compiled for AVX2, see cpu_backend.cpp; without AVX the compiler
+// splits each compare in two and the walk is several times slower than with W = 4). Host only.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
+#include "snag/bvh/complete_tree.h"
+#include "snag/bvh/tree.h"
+#include "snag/geom/box.h"
+
+namespace snag::bvh {
+
+/// log2 of the group width W (4 or 8).
+template <int W>
+constexpr int kGroupShift = W == 8 ? 3 : 2;
+
+/// The level whose nodes are the groups of W leaves: D - log2(W), where every node is internal
+/// and holds W / 2 to W leaves (those of levels D - 1 and D below it); the root for a tree of
+/// fewer levels.
+template <int W>
+inline int32_t group_level(const CompleteTree& shape) {
+  return shape.depth >= kGroupShift<W> ? shape.depth - kGroupShift<W> : 0;
+}
+
+/// The nodes of group_level<W>(): [first, last), in leaf order.
+template <int W>
+inline void group_range(const CompleteTree& shape, int32_t& first, int32_t& last) {
+  const int32_t level = group_level<W>(shape);
+  first = CompleteTree::level_begin(level);
+  last = std::min(CompleteTree::level_begin(level + 1), shape.node_count());
+}
+
+/// W floats and W int32 as one vector each (explicit sizes: GCC ignores a vector_size that
+/// depends on a template parameter).
+template <int W>
+struct LaneVectors;
+template <>
+struct LaneVectors<4> {
+  typedef float Floats __attribute__((vector_size(16)));
+  typedef int32_t Ints __attribute__((vector_size(16)));
+};
+template <>
+struct LaneVectors<8> {
+  typedef float Floats __attribute__((vector_size(32)));
+  typedef int32_t Ints __attribute__((vector_size(32)));
+};
+
+/// The (up to W) leaves under node `group` of group_level<W>() as SIMD lanes: their boxes and
+/// triangles. Absent lanes get an empty box and are masked out.
+template <int W>
+struct LeafLanes {
+  static_assert(W == 4 || W == 8, "groups of 4 or 8 leaves");
+  using Lanes = typename LaneVectors<W>::Floats;
+  using Mask = typename LaneVectors<W>::Ints;
+  Lanes lo[3], hi[3];
+  Mask present;
+  int32_t triangle[W];
+  int32_t leaf[W];
+  int32_t members = 0;  ///< W / 2 .. W (fewer when the whole tree is that small)
+
+  LeafLanes(const TreeView& tree, int32_t group) {
+    int32_t begin, end;
+    tree.shape.positions_under(group, begin, end);
+    members = end - begin;
+    for (int lane = 0; lane < W; ++lane) {
+      geom::Box3f box = geom::empty_box();
+      triangle[lane] = leaf[lane] = -1;
+      if (lane < members) {
+        leaf[lane] = tree.shape.leaf_at(begin + lane);
+        box = tree.boxes[leaf[lane]];
+        triangle[lane] = tree.triangle_at[begin + lane];
+      }
+      for (int k = 0; k < 3; ++k) {
+        lo[k][lane] = box.lo[k];
+        hi[k][lane] = box.hi[k];
+      }
+      // The empty box is not enough: a leaf box that reaches +-FLT_MAX on every axis
+      // (coordinates beyond the float range) overlaps it.
+      present[lane] = lane < members ? -1 : 0;
+    }
+  }
+
+  /// A bit per lane whose box overlaps `box`. (Vectors are passed by reference and never
+  /// returned: a 32-byte vector in a call would have another ABI with AVX than without.)
+  uint32_t overlaps(const geom::Box3f& box) const {
+    const Mask mask = (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
+                      (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) &
+                      present;
+    return bits(mask);
+  }
+
+  /// Bit `lane` of the result set for each lane whose mask is set (all ones), from the sign
+  /// bits of each 16-byte half or whole (one instruction each; a lane-by-lane extraction was a
+  /// third of the walk's time).
+  static uint32_t bits(const Mask& mask) {
+    uint32_t out = 0;
+#if defined(__SSE2__)
+    for (int part = 0; part < W / 4; ++part) {
+      __m128 quarter;
+      std::memcpy(&quarter, reinterpret_cast<const char*>(&mask) + 16 * part, sizeof quarter);
+      out |= static_cast<uint32_t>(_mm_movemask_ps(quarter)) << (4 * part);
+    }
+#else
+    for (int lane = 0; lane < W; ++lane) out |= static_cast<uint32_t>(mask[lane] & 1) << lane;
+#endif
+    return out;
+  }
+
+  /// Walks `tree`'s subtree under `root` for all lanes at once (walk_subtree), descending where
+  /// any lane overlaps; at a leaf, calls visit_leaf(lane_bits, leaf's triangle) with a bit per
+  /// lane that overlaps it (at least one).
+  template <class VisitLeaf>
+  void walk_leaves(const TreeView& tree, int32_t root, VisitLeaf&& visit_leaf) const {
+    uint32_t last = 0;
+    walk_subtree(
+        tree, root,
+        [&](int32_t i) {
+          last = overlaps(tree.boxes[i]);
+          return last != 0;
+        },
+        [&](int32_t i) { visit_leaf(last, tree.triangle_at[tree.shape.position_of(i)]); });
+  }
+
+  /// A visit_leaf for walk_leaves and for_each_later that calls visit(lane triangle, leaf's
+  /// triangle) for each lane in its bits.
+  template <class Visit>
+  auto each_lane(Visit& visit) const {
+    return [this, &visit](uint32_t lanes, int32_t other) {
+      for (; lanes; lanes &= lanes - 1) visit(triangle[count_trailing_zeros(lanes)], other);
+    };
+  }
+
+  /// walk_leaves, calling visit(lane triangle, leaf's triangle) for each overlapping lane.
+  template <class Visit>
+  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
+    walk_leaves(tree, root, each_lane(visit));
+  }
+
+  /// The query of for_each_later_overlap for every member at once (this group's node is
+  /// `group`): calls visit_leaf(lane_bits, other_triangle) for every later leaf, with a bit for
+  /// each member whose box overlaps it, so that each unordered pair is visited once. Pairs of
+  /// members come first, as (bit of the earlier member, later member's triangle).
+  template <class VisitLeaf>
+  void for_each_later(const TreeView& tree, int32_t group, VisitLeaf&& visit_leaf) const {
+    for (int a = 0; a < members; ++a)
+      for (int b = a + 1; b < members; ++b)
+        if (geom::overlap(tree.boxes[leaf[a]], tree.boxes[leaf[b]]))
+          visit_leaf(1u << a, triangle[b]);
+    // Members against the later subtrees: the right siblings of the group's left-child
+    // ancestors.
+    for (int32_t node = group; node > 0; node = (node - 1) >> 1)
+      if (node & 1) walk_leaves(tree, node + 1, visit_leaf);
+  }
+};
+
+/// The per-leaf query of for_each_later_overlap, run for the (up to W) leaves under node
+/// `group` of group_level<W>() at once: calls visit(member_triangle, other_triangle) for every
+/// pair of a member and a later leaf whose boxes overlap, each unordered pair once. The members
+/// share every ancestor above the group, so their walks through the later subtrees are one walk
+/// (LeafLanes::for_each_later). Memory: a few registers and the W boxes.
+template <int W, class Visit>
+inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
+  const LeafLanes<W> lanes(tree, group);
+  lanes.for_each_later(tree, group, lanes.each_lane(visit));
+}
+
+/// for_each_overlap for the (up to W) leaves under node `group` of `tree` (group_level<W>())
+/// against every leaf of `other`: calls visit(member_triangle, other_triangle) for every pair
+/// whose boxes overlap.
+template <int W, class Visit>
+inline void for_each_overlap_grouped(TreeView tree, int32_t group, TreeView other, Visit&& visit) {
+  const LeafLanes<W> lanes(tree, group);
+  lanes.walk(other, 0, visit);
+}
+
+}  // namespace snag::bvh
