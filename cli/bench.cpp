@@ -88,7 +88,8 @@ Row run_case(const BenchCase& c, const BenchOptions& o) {
     cgal_sequence.set_positions(m.positions);
     const auto reference = cgal_sequence.self_intersections();
     const double cgal_seconds = std::chrono::duration<double>(Clock::now() - cgal_started).count();
-    if (validators::pair_ids(r.pairs) != reference || validators::pair_ids(built.pairs) != reference) {
+    if (validators::pair_ids(r.pairs) != reference ||
+        validators::pair_ids(built.pairs) != reference) {
       row.same = false;
       row.note = "frame " + std::to_string(it % meshes.size()) + ": snag " +
                  std::to_string(r.pairs.size()) + " pairs, CGAL " +

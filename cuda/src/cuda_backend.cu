@@ -456,6 +456,7 @@ class CudaBackendImpl final : public CudaBackend {
   void ensure_result_capacity(uint64_t hits, uint64_t uncertain, uint64_t duplicates,
                               uint64_t pairs, uint64_t listed, uint64_t subwalks) {
     listed_.reserve(listed);
+    screened_.reserve(listed);
     subwalks_.reserve(subwalks);
     hits_.reserve(hits);
     uncertain_.reserve(uncertain);
@@ -562,6 +563,7 @@ class CudaBackendImpl final : public CudaBackend {
   unsigned max_blocks_ = 1;
   EventTimer detect_timer_;
   DeviceBuffer<uint64_t> listed_;    // a check's candidate pairs, from its walks to its tests
+  DeviceBuffer<uint64_t> screened_;  // those past the screen, to the whole test (as many slots)
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
   uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
@@ -647,7 +649,8 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   results.edge_face_offsets = topo_.edge_face_offsets.data();
   PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
               pair_keys_.capacity()};
-  const CandidateList listed{listed_.data(), listed_.capacity()};
+  const CandidateList listed{listed_.data(), std::min(listed_.capacity(), screened_.capacity()),
+                             screened_.data()};
   const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
   HostResults out = host_results_;
   out.limit = finish_limit_;
@@ -659,10 +662,12 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
     // Each check lists its subwalks and candidates from the start of their lists (the first
     // finds them cleared with the rest).
     static_assert(offsetof(FrameCounters, subwalks) ==
-                  offsetof(FrameCounters, listed) + sizeof(unsigned long long));
+                      offsetof(FrameCounters, listed) + sizeof(unsigned long long) &&
+                  offsetof(FrameCounters, screened) ==
+                      offsetof(FrameCounters, listed) + 2 * sizeof(unsigned long long));
     if (i > 0)
       SNAG_CUDA_CHECK(
-          cudaMemsetAsync(&counters_.data()->listed, 0, 2 * sizeof(unsigned long long), s));
+          cudaMemsetAsync(&counters_.data()->listed, 0, 3 * sizeof(unsigned long long), s));
     if (check.self()) {
       if (part_size(check.a) > 0)
         launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, subwalks, listed,
@@ -734,7 +739,8 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     c = *counters_host_.data();
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
-        c.listed_most <= listed_.capacity() && c.subwalks_most <= subwalks_.capacity())
+        c.listed_most <= std::min(listed_.capacity(), screened_.capacity()) &&
+        c.subwalks_most <= subwalks_.capacity())
       break;
     // The next run fits, but for the stages after one that overflowed: a subwalk list that
     // overflowed left pairs unlisted, a candidate list that overflowed left hits unfound, so

@@ -241,6 +241,53 @@ __global__ void __launch_bounds__(kBlock)
   add_warp_total(sink.expanded, &out.counters->expanded);
 }
 
+/// The filtered path's pair tests in two launches. This one, light (few registers, so many
+/// warps to hide its loads), screens every listed pair as pair_test_kernel does up to the
+/// rejection by sides and keeps the pairs that get past it (a small share: 4% of a cloth's
+/// neighbour pairs) for screened_test_kernel, which runs the whole test on them. In one kernel,
+/// the edge tests' registers held every warp of the screen to a third of the SM's slots, and
+/// each warp waited on its few threads that went on to edge tests.
+__global__ void __launch_bounds__(kBlock)
+    pair_screen_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
+                       CandidateList listed, FrameCounters* counters) {
+  unsigned long long candidates = 0;
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
+  const unsigned long long listed_count = counters->listed;
+  if (first == 0) atomicMax(&counters->listed_most, listed_count);
+  const unsigned long long tested = min(listed_count, listed.capacity);
+  for (unsigned long long i = first; i < tested; i += stride) {
+    const uint64_t pair = listed.pairs[i];
+    const auto t = static_cast<int32_t>(pair >> 32);
+    const auto leaf = static_cast<int32_t>(pair & 0xffffffffu);
+    const int32_t x = walked_base + walked.triangle_at[walked.shape.position_of(leaf)];
+    if (in.degenerate[x]) continue;
+    ++candidates;
+    uint32_t t_shared, x_shared;
+    detect::shared_corners(in.topology.triangles[t], in.topology.triangles[x], t_shared, x_shared);
+    if (detect::pair_passes_sides(in.frame, in.topology, t, x, t_shared, x_shared))
+      listed.screened[claim_slot(&counters->screened)] = pack(t, x);
+  }
+  add_warp_total(candidates, &counters->candidates);
+}
+
+/// The whole pair test of each pair the screen kept (at most one per listed pair stored, so
+/// the list never overflows), striding over their count.
+__global__ void __launch_bounds__(kBlock)
+    screened_test_kernel(PairInputs in, CandidateList listed, ResultBuffers out) {
+  DeviceSink sink{out};
+  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
+  const unsigned long long count = out.counters->screened;
+  for (unsigned long long i = first; i < count; i += stride) {
+    const uint64_t pair = listed.screened[i];
+    detect::test_candidate_pair(in.frame, in.topology, static_cast<int32_t>(pair >> 32),
+                                static_cast<int32_t>(pair & 0xffffffffu), sink);
+  }
+  add_warp_total(sink.misses, &out.counters->misses);
+  add_warp_total(sink.expanded, &out.counters->expanded);
+}
+
 /// Adds pair `key` to the set; the thread that inserts it classifies it and appends it.
 __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::Vec3d* positions,
                                             const geom::Tri* triangles, const PairSet& set,
@@ -420,10 +467,12 @@ void launch_counted(void (*kernel)(Params...), unsigned long long bound, unsigne
 void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, int32_t walked_base,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
-  if (use == detect::FilterUse::certify)
-    launch_counted(pair_test_kernel<detect::FilterUse::certify>, listed.capacity, max_blocks,
-                   stream, inputs, walked, walked_base, listed, results);
-  else
+  if (use == detect::FilterUse::certify) {
+    launch_counted(pair_screen_kernel, listed.capacity, max_blocks, stream, inputs, walked,
+                   walked_base, listed, results.counters);
+    launch_counted(screened_test_kernel, listed.capacity, max_blocks, stream, inputs, listed,
+                   results);
+  } else
     launch_counted(pair_test_kernel<detect::FilterUse::defer_all>, listed.capacity, max_blocks,
                    stream, inputs, walked, walked_base, listed, results);
 }

@@ -30,7 +30,8 @@ struct FrameCounters {
   unsigned long long listed;         ///< the current check's walks: candidate pairs they listed
   unsigned long long subwalks;       ///< the current check's walks above the split level: the
                                      ///< subwalks they handed over (zeroed with `listed` before
-                                     ///< each check, the two side by side)
+                                     ///< each check, the three side by side)
+  unsigned long long screened;       ///< the current check's listed pairs past the screen
   unsigned long long listed_most;    ///< the most any check of the frame listed (entries wanted
                                      ///< in the candidate list)
   unsigned long long subwalks_most;  ///< likewise for the subwalk list
@@ -42,6 +43,9 @@ struct FrameCounters {
 struct CandidateList {
   uint64_t* pairs = nullptr;
   unsigned long long capacity = 0;
+  /// The (t << 32 | x) pairs that pass the screen (detect::pair_passes_sides), as many slots
+  /// as `pairs`: at most every pair stored there passes.
+  uint64_t* screened = nullptr;
 };
 
 /// Where a check's walks above the split level (bvh::split_walk_level) hand over the rest of

@@ -16,7 +16,8 @@ struct SmallMesh {
 };
 
 inline detect::FrameResult check_mesh(
-    const SmallMesh& mesh, int threads = 2, std::shared_ptr<detect::ExactResolver> resolver = nullptr,
+    const SmallMesh& mesh, int threads = 2,
+    std::shared_ptr<detect::ExactResolver> resolver = nullptr,
     detect::CpuWalkWidth width = detect::CpuWalkWidth::automatic) {
   if (!resolver) resolver = std::make_shared<IntegerResolver>();
   detect::Checker checker(detect::make_cpu_backend(threads, width), resolver);

@@ -36,8 +36,8 @@ TEST(SceneCheck, PairsAreTheBruteForcePairsOfTheChecksAsked) {
     for (const auto& checks : check_sets)
       for (int threads : {1, 3}) {
         // Both walk widths, alternately (groups of 4 and 8 leaves, within and between parts).
-        const auto width = (seed + threads) % 2 ? detect::CpuWalkWidth::four
-                                                : detect::CpuWalkWidth::eight;
+        const auto width =
+            (seed + threads) % 2 ? detect::CpuWalkWidth::four : detect::CpuWalkWidth::eight;
         auto checker = make_checker(threads, width);
         checker->set_scene(laid.mesh.triangles, static_cast<int32_t>(laid.mesh.positions.size()),
                            laid.layout, checks);

@@ -131,14 +131,14 @@ inline void walk_between_group(const WalkInput& in, int32_t group, ThreadSink& s
 #if defined(__x86_64__) && defined(__GNUC__)
 #define SNAG_HAVE_AVX2_WALK 1
 template <FilterUse use>
-[[gnu::target("avx2"), gnu::flatten]] void walk_self_group_avx2(const WalkInput& in,
-                                                                 int32_t group, ThreadSink& sink) {
+[[gnu::target("avx2"), gnu::flatten]] void walk_self_group_avx2(const WalkInput& in, int32_t group,
+                                                                ThreadSink& sink) {
   walk_self_group<8, use>(in, group, sink);
 }
 template <FilterUse use>
 [[gnu::target("avx2"), gnu::flatten]] void walk_between_group_avx2(const WalkInput& in,
-                                                                    int32_t group,
-                                                                    ThreadSink& sink) {
+                                                                   int32_t group,
+                                                                   ThreadSink& sink) {
   walk_between_group<8, use>(in, group, sink);
 }
 #endif
@@ -306,7 +306,7 @@ class CpuBackend final : public Backend {
     const Topology& topo = *topology_;
     const int32_t base = topo.layout.triangle_begin[part];
     if (topo.layout.triangle_begin[part + 1] == base) return;
-    const WalkInput in{trees_[part].view(), base, {}, 0, &frame_view, &view,
+    const WalkInput in{trees_[part].view(),    base, {}, 0, &frame_view, &view,
                        degenerate_flags.data()};
     const int64_t neighbor_begin = topo.self_neighbors[2 * part];
     const int64_t neighbor_end = topo.self_neighbors[2 * part + 1];
@@ -346,9 +346,12 @@ class CpuBackend final : public Backend {
     };
     if (size(a) == 0 || size(b) == 0) return;
     if (size(a) < size(b)) std::swap(a, b);
-    const WalkInput in{trees_[a].view(),     topo.layout.triangle_begin[a],
-                       trees_[b].view(),     topo.layout.triangle_begin[b],
-                       &frame_view,          &view,
+    const WalkInput in{trees_[a].view(),
+                       topo.layout.triangle_begin[a],
+                       trees_[b].view(),
+                       topo.layout.triangle_begin[b],
+                       &frame_view,
+                       &view,
                        degenerate_flags.data()};
 #pragma omp parallel num_threads(threads_)
     {

@@ -96,8 +96,7 @@ struct LeafLanes {
   /// returned: a 32-byte vector in a call would have another ABI with AVX than without.)
   uint32_t overlaps(const geom::Box3f& box) const {
     const Mask mask = (lo[0] <= box.hi[0]) & (hi[0] >= box.lo[0]) & (lo[1] <= box.hi[1]) &
-                      (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) &
-                      present;
+                      (hi[1] >= box.lo[1]) & (lo[2] <= box.hi[2]) & (hi[2] >= box.lo[2]) & present;
     return bits(mask);
   }
 

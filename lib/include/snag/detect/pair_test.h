@@ -157,6 +157,21 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
   if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, x_shared, t, tt, side_x, sink);
 }
 
+/// Whether test_pair_given_shared(frame, topo, t, x, t_shared, x_shared, ...) gets past the
+/// rejection by sides, so that it has anything to report: false exactly when it returns after
+/// the sides with no report. The same sides, computed the same way, so a GPU can screen its
+/// pairs with it in a light kernel and hand only the rest to the full test.
+SNAG_HD_INLINE bool pair_passes_sides(const FrameView& frame, const TopologyView& topo, int32_t t,
+                                      int32_t x, uint32_t t_shared, uint32_t x_shared) {
+  if (t_shared == 7u) return true;  // a duplicated face: reported as one
+  const geom::Tri tt = topo.triangles[t], xt = topo.triangles[x];
+  geom::Sign side[3];
+  sides_against(frame.positions, frame.planes[x], tt, t_shared, xt, side);
+  if (separated(side, t_shared)) return false;
+  sides_against(frame.positions, frame.planes[t], xt, x_shared, tt, side);
+  return !separated(side, x_shared);
+}
+
 /// The narrow phase of (t, x) with the filter left out (`--exact all`): every edge-triangle
 /// test the pair needs is reported uncertain, for exact predicates to decide; no sign is
 /// computed. Duplicated faces are found by their ids, as in test_pair_given_shared.
