@@ -659,8 +659,8 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   for (size_t i = 0; i < checks.size(); ++i) {
     const detect::PartCheck check = topology_->checks[checks[i]];
     if (time_each) check_timers_[i]->start(s);
-    // Each check lists its subwalks and candidates from the start of their lists (the first
-    // finds them cleared with the rest).
+    // Each check lists its subwalks, candidates and screened pairs from the start of their
+    // lists (the first finds them cleared with the rest).
     static_assert(offsetof(FrameCounters, subwalks) ==
                       offsetof(FrameCounters, listed) + sizeof(unsigned long long) &&
                   offsetof(FrameCounters, screened) ==
