@@ -141,23 +141,26 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream);
 
-/// A part against itself, in three launches. The walks, split at bvh::split_walk_level: one
+/// A part against itself, in four launches. The walks, split at bvh::split_walk_level: one
 /// thread per leaf position of its tree (in leaf order; the tree's triangle ids plus `base`
 /// are the topology's) walks the later leaves' subtrees down to that level, handing every
 /// overlapping node there to `subwalks`; then one thread per subwalk walks that node's
 /// subtree, listing every overlapping leaf into `listed`, counted in
-/// results.counters->listed (which the caller zeroes first, with ->subwalks). The longest walk
-/// of a folded region's leaf (267 box tests at 36K) was the walk kernel's time, at two warps
-/// per scheduler: split, it is two chains of at most ~60, the second over three times as
-/// many threads. The pair tests: one per listed pair, through detect::test_candidate_pair
-/// (shared corners from the ids; degenerate triangles left out). The listed pairs are the
-/// CPU's neighbour pairs and traversal candidates together, each once: triangles that share
-/// a vertex always have overlapping boxes. Listing first keeps the walk to box tests (a walk
+/// results.counters->listed (which the caller zeroes first, with ->subwalks and ->screened).
+/// The longest walk of a folded region's leaf (267 box tests at 36K) was the walk kernel's
+/// time, at two warps per scheduler: split, it is two chains of at most ~60, the second over
+/// three times as many threads. The pair tests: a light screen over every listed pair (shared
+/// corners from the ids, degenerate triangles left out, then detect::pair_passes_sides) keeps
+/// the pairs that get past the rejection by sides in listed.screened, and the whole test
+/// (detect::test_candidate_pair) runs on those alone. The listed pairs are the CPU's
+/// neighbour pairs and traversal candidates together, each once: triangles that share a
+/// vertex always have overlapping boxes. Listing first keeps the walk to box tests (a walk
 /// that tested its pairs, or loaded anything at its leaves, held its warp's other walks back
 /// each time), and spreads the tests of a folded region's leaves over the whole device. With
-/// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`); a kernel of
-/// its own, so that the usual one carries no branch for it. The subwalks run one per thread;
-/// the pair tests on at most `max_blocks` blocks (striding over the list when longer).
+/// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`), in one pair
+/// test kernel of its own: it computes no sides to screen with. The subwalks run one per
+/// thread; the pair tests on at most `max_blocks` blocks (striding over their list when
+/// longer).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const SubwalkList& subwalks, const CandidateList& listed,
                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
