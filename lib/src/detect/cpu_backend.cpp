@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <type_traits>
 
 #include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
@@ -123,6 +122,18 @@ inline void walk_between_group(const WalkInput& in, int32_t group, ThreadSink& s
   });
 }
 
+/// Which walk a check's groups run: a part against its own later leaves, or against the other
+/// part's whole tree.
+enum class GroupWalk { self, between };
+
+template <GroupWalk kind, int W, FilterUse use>
+inline void walk_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
+  if constexpr (kind == GroupWalk::self)
+    walk_self_group<W, use>(in, group, sink);
+  else
+    walk_between_group<W, use>(in, group, sink);
+}
+
 // Groups of eight, compiled for AVX2 and called only where the CPU has it. Everything a group
 // walk calls is inlined here (flatten), so that the 32-byte vectors of LeafLanes<8> are single
 // AVX instructions and nothing compiled for AVX2 is shared with the rest of the program. AVX2
@@ -130,16 +141,10 @@ inline void walk_between_group(const WalkInput& in, int32_t group, ThreadSink& s
 // round as everywhere else.
 #if defined(__x86_64__) && defined(__GNUC__)
 #define SNAG_HAVE_AVX2_WALK 1
-template <FilterUse use>
-[[gnu::target("avx2"), gnu::flatten]] void walk_self_group_avx2(const WalkInput& in, int32_t group,
-                                                                ThreadSink& sink) {
-  walk_self_group<8, use>(in, group, sink);
-}
-template <FilterUse use>
-[[gnu::target("avx2"), gnu::flatten]] void walk_between_group_avx2(const WalkInput& in,
-                                                                   int32_t group,
-                                                                   ThreadSink& sink) {
-  walk_between_group<8, use>(in, group, sink);
+template <GroupWalk kind, FilterUse use>
+[[gnu::target("avx2"), gnu::flatten]] void walk_group_avx2(const WalkInput& in, int32_t group,
+                                                           ThreadSink& sink) {
+  walk_group<kind, 8, use>(in, group, sink);
 }
 #endif
 
@@ -321,16 +326,7 @@ class CpuBackend final : public Backend {
         const uint32_t shared = topo.neighbor_shared[i];
         test_pair<use>(frame_view, view, t, x, shared & 7u, shared >> 3, sink);
       }
-      for_each_group(in.tree, [&](auto lanes, int32_t group) {
-        if constexpr (decltype(lanes)::value == 4) {
-          walk_self_group<4, use>(in, group, sink);
-        } else {
-#if defined(SNAG_HAVE_AVX2_WALK)
-          if (avx2_) return walk_self_group_avx2<use>(in, group, sink);
-#endif
-          walk_self_group<8, use>(in, group, sink);
-        }
-      });
+      walk_groups<GroupWalk::self, use>(in, sink);
     }
   }
 
@@ -356,34 +352,33 @@ class CpuBackend final : public Backend {
 #pragma omp parallel num_threads(threads_)
     {
       ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
-      for_each_group(in.tree, [&](auto lanes, int32_t group) {
-        if constexpr (decltype(lanes)::value == 4) {
-          walk_between_group<4, use>(in, group, sink);
-        } else {
-#if defined(SNAG_HAVE_AVX2_WALK)
-          if (avx2_) return walk_between_group_avx2<use>(in, group, sink);
-#endif
-          walk_between_group<8, use>(in, group, sink);
-        }
-      });
+      walk_groups<GroupWalk::between, use>(in, sink);
     }
   }
 
-  /// Inside a parallel region: walk(width, group) for every group of the chosen width
-  /// (std::integral_constant 4 or 8), shared among the threads in dynamic chunks of 256 leaves.
-  template <class Walk>
-  void for_each_group(const bvh::TreeView& tree, Walk&& walk) const {
+  /// Inside a parallel region: the `kind` walk of every group of in.tree at the chosen width
+  /// (of 8 leaves through walk_group_avx2 where the CPU has AVX2), shared among the threads in
+  /// dynamic chunks of 256 leaves.
+  template <GroupWalk kind, FilterUse use>
+  void walk_groups(const WalkInput& in, ThreadSink& sink) const {
     int32_t first_group, last_group;
     if (wide_) {
-      bvh::group_range<8>(tree.shape, first_group, last_group);
+      bvh::group_range<8>(in.tree.shape, first_group, last_group);
 #pragma omp for schedule(dynamic, 32)
-      for (int32_t group = first_group; group < last_group; ++group)
-        walk(std::integral_constant<int, 8>{}, group);
+      for (int32_t group = first_group; group < last_group; ++group) {
+#if defined(SNAG_HAVE_AVX2_WALK)
+        if (avx2_) {
+          walk_group_avx2<kind, use>(in, group, sink);
+          continue;
+        }
+#endif
+        walk_group<kind, 8, use>(in, group, sink);
+      }
     } else {
-      bvh::group_range<4>(tree.shape, first_group, last_group);
+      bvh::group_range<4>(in.tree.shape, first_group, last_group);
 #pragma omp for schedule(dynamic, 64)
       for (int32_t group = first_group; group < last_group; ++group)
-        walk(std::integral_constant<int, 4>{}, group);
+        walk_group<kind, 4, use>(in, group, sink);
     }
   }
 
@@ -397,7 +392,7 @@ class CpuBackend final : public Backend {
 
   int threads_;
   bool wide_;  ///< groups of 8 leaves, else 4
-  bool avx2_;  ///< the CPU has AVX2: groups of 8 run walk_*_group_avx2
+  bool avx2_;  ///< the CPU has AVX2: groups of 8 run walk_group_avx2
   const Topology* topology_ = nullptr;
   std::span<const geom::Vec3d> positions_;
   std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
