@@ -468,6 +468,10 @@ class CudaBackendImpl final : public CudaBackend {
     table_.reserve(table);
   }
 
+  /// The pairs a check may list: every one stored may pass the screen, so the screened list
+  /// holds as many (the two are reserved together).
+  uint64_t candidate_capacity() const { return std::min(listed_.capacity(), screened_.capacity()); }
+
   /// With some slack, so that a sequence whose counts creep up does not run every frame twice.
   static uint64_t grown(uint64_t count) { return count + count / 2 + 1024; }
 
@@ -649,8 +653,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   results.edge_face_offsets = topo_.edge_face_offsets.data();
   PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
               pair_keys_.capacity()};
-  const CandidateList listed{listed_.data(), std::min(listed_.capacity(), screened_.capacity()),
-                             screened_.data()};
+  const CandidateList listed{listed_.data(), candidate_capacity(), screened_.data()};
   const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
   HostResults out = host_results_;
   out.limit = finish_limit_;
@@ -739,8 +742,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     c = *counters_host_.data();
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
-        c.listed_most <= std::min(listed_.capacity(), screened_.capacity()) &&
-        c.subwalks_most <= subwalks_.capacity())
+        c.listed_most <= candidate_capacity() && c.subwalks_most <= subwalks_.capacity())
       break;
     // The next run fits, but for the stages after one that overflowed: a subwalk list that
     // overflowed left pairs unlisted, a candidate list that overflowed left hits unfound, so

@@ -211,64 +211,65 @@ __global__ void __launch_bounds__(kBlock)
   lister.finish();
 }
 
-/// The pair tests of one check, one per listed (t, leaf of `walked`) pair: the leaf's triangle,
-/// `walked_base` added, is x; pairs with a degenerate triangle are left out, the others tested
-/// with their shared corners (detect::test_candidate_pair). The kernel is queued before the
-/// walk's count is known: a fixed grid (launch_counted) strides over the listed pairs.
-template <detect::FilterUse use>
-__global__ void __launch_bounds__(kBlock)
-    pair_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base, CandidateList listed,
-                     ResultBuffers out) {
-  DeviceSink sink{out};
-  unsigned long long candidates = 0;
-  const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
-  const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
-  const unsigned long long listed_count = out.counters->listed;
-  if (first == 0) atomicMax(&out.counters->listed_most, listed_count);
-  const unsigned long long tested = min(listed_count, listed.capacity);
-  for (unsigned long long i = first; i < tested; i += stride) {
-    const uint64_t pair = listed.pairs[i];
-    const auto t = static_cast<int32_t>(pair >> 32);
-    const auto leaf = static_cast<int32_t>(pair & 0xffffffffu);
-    const int32_t x = walked_base + walked.triangle_at[walked.shape.position_of(leaf)];
-    if (!in.degenerate[x]) {
-      ++candidates;
-      detect::test_candidate_pair<use>(in.frame, in.topology, t, x, sink);
-    }
-  }
-  add_warp_total(candidates, &out.counters->candidates);
-  add_warp_total(sink.misses, &out.counters->misses);
-  add_warp_total(sink.expanded, &out.counters->expanded);
-}
-
-/// The filtered path's pair tests in two launches. This one, light (few registers, so many
-/// warps to hide its loads), screens every listed pair as pair_test_kernel does up to the
-/// rejection by sides and keeps the pairs that get past it (a small share: 4% of a cloth's
-/// neighbour pairs) for screened_test_kernel, which runs the whole test on them. In one kernel,
-/// the edge tests' registers held every warp of the screen to a third of the SM's slots, and
-/// each warp waited on its few threads that went on to edge tests.
-__global__ void __launch_bounds__(kBlock)
-    pair_screen_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
-                       CandidateList listed, FrameCounters* counters) {
+/// Calls visit(t, x) for each pair of the current check's list whose x (the leaf's triangle,
+/// `walked_base` added) is not degenerate, the grid's threads striding over the pairs stored;
+/// records the most listed and adds the pairs visited to counters->candidates. Every thread of
+/// the block must call it (the count is a warp sum).
+template <class Visit>
+__device__ __forceinline__ void for_each_listed_pair(const PairInputs& in,
+                                                     const bvh::TreeView& walked,
+                                                     int32_t walked_base,
+                                                     const CandidateList& listed,
+                                                     FrameCounters* counters, Visit&& visit) {
   unsigned long long candidates = 0;
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long listed_count = counters->listed;
   if (first == 0) atomicMax(&counters->listed_most, listed_count);
-  const unsigned long long tested = min(listed_count, listed.capacity);
-  for (unsigned long long i = first; i < tested; i += stride) {
+  const unsigned long long stored = min(listed_count, listed.capacity);
+  for (unsigned long long i = first; i < stored; i += stride) {
     const uint64_t pair = listed.pairs[i];
     const auto t = static_cast<int32_t>(pair >> 32);
     const auto leaf = static_cast<int32_t>(pair & 0xffffffffu);
     const int32_t x = walked_base + walked.triangle_at[walked.shape.position_of(leaf)];
     if (in.degenerate[x]) continue;
     ++candidates;
+    visit(t, x);
+  }
+  add_warp_total(candidates, &counters->candidates);
+}
+
+/// The pair tests of one check with the filter left out (`--exact all`), one per listed (t,
+/// leaf of `walked`) pair: every edge-triangle test the pair needs goes to the uncertain
+/// buffer (detect::test_candidate_pair with defer_all computes no sides, so there is nothing
+/// to screen). The kernel is queued before the walk's count is known: a fixed grid
+/// (launch_counted) strides over the listed pairs.
+__global__ void __launch_bounds__(kBlock)
+    deferred_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
+                         CandidateList listed, ResultBuffers out) {
+  DeviceSink sink{out};
+  for_each_listed_pair(in, walked, walked_base, listed, out.counters, [&](int32_t t, int32_t x) {
+    detect::test_candidate_pair<detect::FilterUse::defer_all>(in.frame, in.topology, t, x, sink);
+  });
+  add_warp_total(sink.misses, &out.counters->misses);
+  add_warp_total(sink.expanded, &out.counters->expanded);
+}
+
+/// The filtered path's pair tests in two launches. This one, light (few registers, so many
+/// warps to hide its loads), screens every listed pair (shared corners from the ids, degenerate
+/// triangles left out) up to the rejection by sides and keeps the pairs that get past it (a small
+/// share: 4% of a cloth's neighbour pairs) for screened_test_kernel, which runs the whole test on
+/// them. In one kernel, the edge tests' registers held every warp of the screen to a third of the
+/// SM's slots, and each warp waited on its few threads that went on to edge tests.
+__global__ void __launch_bounds__(kBlock)
+    pair_screen_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
+                       CandidateList listed, FrameCounters* counters) {
+  for_each_listed_pair(in, walked, walked_base, listed, counters, [&](int32_t t, int32_t x) {
     uint32_t t_shared, x_shared;
     detect::shared_corners(in.topology.triangles[t], in.topology.triangles[x], t_shared, x_shared);
     if (detect::pair_passes_sides(in.frame, in.topology, t, x, t_shared, x_shared))
       listed.screened[claim_slot(&counters->screened)] = pack(t, x);
-  }
-  add_warp_total(candidates, &counters->candidates);
+  });
 }
 
 /// The whole pair test of each pair the screen kept (at most one per listed pair stored, so
@@ -473,8 +474,8 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
     launch_counted(screened_test_kernel, listed.capacity, max_blocks, stream, inputs, listed,
                    results);
   } else
-    launch_counted(pair_test_kernel<detect::FilterUse::defer_all>, listed.capacity, max_blocks,
-                   stream, inputs, walked, walked_base, listed, results);
+    launch_counted(deferred_test_kernel, listed.capacity, max_blocks, stream, inputs, walked,
+                   walked_base, listed, results);
 }
 
 /// A grid for the subwalks expected, one per thread. Capped at max_blocks (as the pair tests
