@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstring>
 #include <cub/device/device_radix_sort.cuh>
+#include <utility>
 
 #include "cuda_check.cuh"
 #include "detect_kernels.cuh"
@@ -58,7 +59,9 @@ class CudaBackendImpl final : public CudaBackend {
     upload_stream_ = std::make_unique<Stream>();
     counters_.reserve(1);
     counters_host_.reserve(1);
-    scan_counters_host_.reserve(1);
+    scan_counters_.reserve(1);
+    scan_counts_host_.reserve(1);
+    SNAG_CUDA_CHECK(cudaMemset(scan_counters_.data(), 0, sizeof(ScanCounters)));
     finish_ranks_.reserve(2 * kFinishLimit);
     finish_tickets_.reserve(2 * kFinishSlices);
     SNAG_CUDA_CHECK(cudaMemset(finish_ranks_.data(), 0, 2 * kFinishLimit * sizeof(unsigned)));
@@ -113,18 +116,20 @@ class CudaBackendImpl final : public CudaBackend {
     flagged_.clear();
     scan_degenerate_host_.reserve(std::max<size_t>(n, 1));
     scan_uncertain_host_.reserve(std::max<size_t>(n, 1));
-    host_keys_.reserve(kFinishLimit);
-    host_status_.reserve(kFinishLimit);
+    host_pairs_.reserve(kFinishLimit);
     host_uncertain_.reserve(kFinishLimit);
-    host_results_ = {mapped(host_keys_.data()), mapped(host_status_.data()),
-                     mapped(host_uncertain_.data()), mapped(counters_host_.data()), 0};
+    host_results_ = {mapped(host_pairs_.data()), mapped(host_uncertain_.data()),
+                     mapped(counters_host_.data())};
     planes_.reserve(std::max<size_t>(n, 1));
     for (int slot = 0; slot < 2; ++slot) {
       positions_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
       positions_host_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
     }
     current_positions_ = positions_[positions_slot_].data();
-    pair_bits_ = bits_for(d.triangle_count);
+    pair_bits_ = bits_for(d.triangle_count);  // at most 31: keys leave HostResults' status bits
+    if (2 * pair_bits_ > kStatusShift)
+      throw InternalError("cuda backend: " + std::to_string(d.triangle_count) +
+                          " triangles do not fit the pair keys");
     edge_bits_ = bits_for(d.edge_count);
     // One tree per part, and what each part's device data fits (PartState).
     const int32_t parts = topology.part_count();
@@ -244,20 +249,25 @@ class CudaBackendImpl final : public CudaBackend {
     if (topo_.triangle_count == 0) return scan;
     const cudaStream_t s = stream();
     timer_.start(s);
-    SNAG_CUDA_CHECK(cudaMemsetAsync(counters_.data(), 0, sizeof(FrameCounters), s));
-    for (int32_t p : parts)
-      if (part_size(p) > 0)
-        launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(p),
-                               part_size(p), mapped(scan_degenerate_host_.data()),
-                               mapped(scan_uncertain_host_.data()), counters_.data(), s);
-    SNAG_CUDA_CHECK(cudaMemcpyAsync(scan_counters_host_.data(), counters_.data(),
-                                    sizeof(FrameCounters), cudaMemcpyDeviceToHost, s));
+    // One launch per part; the last publishes the counts into host memory (none: no launch,
+    // and the counts stay zero).
+    size_t last_scanned = parts.size();
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (part_size(parts[i]) > 0) last_scanned = i;
+    ScanCounts* const counts = scan_counts_host_.data();
+    *counts = {};
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (part_size(parts[i]) > 0)
+        launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(parts[i]),
+                               part_size(parts[i]), mapped(scan_degenerate_host_.data()),
+                               mapped(scan_uncertain_host_.data()), scan_counters_.data(),
+                               i == last_scanned ? mapped(counts) : nullptr, s);
     std::vector<int32_t> ahead;
     for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
       if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
         ahead.push_back(p);
     for (int32_t p : ahead) {
-      queue_refit(p);
+      queue_refit(p, /*timed=*/false);  // its time is the scan's
       trees_[p]->queue_quality(s);
     }
     timer_.stop_async(s);
@@ -268,11 +278,10 @@ class CudaBackendImpl final : public CudaBackend {
       part_[p].quality = trees_[p]->queued_quality();
       part_[p].quality_ready = true;
     }
-    const FrameCounters c = *scan_counters_host_.data();
+    const ScanCounts c = *counts;
     scan.degenerate.assign(scan_degenerate_host_.data(),
                            scan_degenerate_host_.data() + c.degenerate);
-    scan.uncertain.assign(scan_uncertain_host_.data(),
-                          scan_uncertain_host_.data() + c.degenerate_uncertain);
+    scan.uncertain.assign(scan_uncertain_host_.data(), scan_uncertain_host_.data() + c.uncertain);
     // Appended in any order: sorted as the CPU gives them.
     std::sort(scan.degenerate.begin(), scan.degenerate.end());
     std::sort(scan.uncertain.begin(), scan.uncertain.end());
@@ -306,7 +315,7 @@ class CudaBackendImpl final : public CudaBackend {
       times_.refit = 0;
       return;
     }
-    queue_refit(p);
+    queue_refit(p, /*timed=*/true);
   }
 
   double part_quality(int32_t p) override {
@@ -432,12 +441,17 @@ class CudaBackendImpl final : public CudaBackend {
     if (!topology_) throw InternalError("cuda backend: no topology set");
   }
 
-  void queue_refit(int32_t p) {
+  /// Queues part p's refit; `timed`: between the refit timer's events, which a refit queued
+  /// ahead by the scan leaves out (the scan's timer covers it, and refit_part() then reports
+  /// 0), so that the scan's launches follow one another with no other step between them.
+  void queue_refit(int32_t p, bool timed) {
     if (part_size(p) == 0) return;  // built empty: nothing to refit
-    refit_timer_.start(stream());
+    if (timed) refit_timer_.start(stream());
     trees_[p]->refit(part_mesh(p), planes_.data() + part_begin(p), stream());
-    refit_timer_.stop_async(stream());
-    refit_pending_ = true;
+    if (timed) {
+      refit_timer_.stop_async(stream());
+      refit_pending_ = true;
+    }
     part_[p].tree_version = part_[p].version;
     part_[p].planes_version = part_[p].version;
     part_[p].quality_ready = false;
@@ -492,6 +506,34 @@ class CudaBackendImpl final : public CudaBackend {
     // forgotten within a few dozen.
     finish_expected_ =
         std::max<uint64_t>(std::max(c.pairs, c.uncertain), finish_expected_ - finish_expected_ / 8);
+  }
+
+  /// frame.pairs and frame.kind_certain from `count` (a << pair_bits_ | b) keys and their
+  /// statuses (bit 0: touching, bit 1: certain), key_and_status(i) giving the i-th.
+  template <class KeyAndStatus>
+  void decode_pairs(size_t count, detect::FilteredFrame& frame,
+                    KeyAndStatus&& key_and_status) const {
+    frame.pairs.resize(count);
+    frame.kind_certain.resize(count);
+    // Through local pointers: with frame.pairs[i] the compiler reloads the vector's storage
+    // after every store to kind_certain (bytes, which may alias anything).
+    detect::FacePair* const pairs = frame.pairs.data();
+    uint8_t* const certain = frame.kind_certain.data();
+    const int bits = pair_bits_;
+    const uint64_t mask = (uint64_t{1} << bits) - 1;
+    for (size_t i = 0; i < count; ++i) {
+      const auto [key, status] = key_and_status(i);
+      pairs[i] = {static_cast<int32_t>(key >> bits), static_cast<int32_t>(key & mask),
+                  static_cast<detect::PairKind>(status & 1)};
+      certain[i] = static_cast<uint8_t>(status >> 1);
+    }
+  }
+  /// frame.uncertain from `count` (edge << 32 | triangle) keys.
+  static void decode_tasks(const uint64_t* keys, size_t count, detect::FilteredFrame& frame) {
+    frame.uncertain.resize(count);
+    detect::EdgeTriangleTask* const tasks = frame.uncertain.data();
+    for (size_t i = 0; i < count; ++i)
+      tasks[i] = {static_cast<int32_t>(keys[i] >> 32), static_cast<int32_t>(keys[i] & 0xffffffffu)};
   }
 
   /// The frame's degenerate flags and edge ownership on the device.
@@ -559,8 +601,9 @@ class CudaBackendImpl final : public CudaBackend {
   PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
-  PinnedBuffer<FrameCounters> counters_host_;       // the detect's, written by finish_kernel
-  PinnedBuffer<FrameCounters> scan_counters_host_;  // the scan's, apart: a detect may follow it
+  PinnedBuffer<FrameCounters> counters_host_;  // the detect's, written by finish_kernel
+  DeviceBuffer<ScanCounters> scan_counters_;   // zero between scans (the scan leaves them so)
+  PinnedBuffer<ScanCounts> scan_counts_host_;  // the last scan's counts, written by its kernel
   DetectCall last_detect_;
   Speculation speculation_;
   uint64_t builds_ = 0;
@@ -581,8 +624,9 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<unsigned char> temp_;
   DeviceBuffer<unsigned> finish_ranks_, finish_tickets_;  // FinishScratch, zero between runs
   // Results in host memory: written by finish_kernel (small frames) or copied (large ones).
-  PinnedBuffer<uint64_t> host_keys_, host_uncertain_, keys_host_, uncertain_host_;
-  PinnedBuffer<uint8_t> host_status_, status_host_;
+  PinnedBuffer<uint64_t> host_pairs_, host_uncertain_;  // HostResults' (pairs with status)
+  PinnedBuffer<uint64_t> keys_host_, uncertain_host_;
+  PinnedBuffer<uint8_t> status_host_;
   // Stage timers whose stop may still be queued: read (and waited for) by collect_times().
   mutable EventTimer upload_timer_, build_timer_, refit_timer_;
   mutable bool upload_pending_ = false, build_pending_ = false, refit_pending_ = false;
@@ -771,9 +815,6 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   const bool large_pairs = c.pairs > finish_limit_, large_tasks = c.uncertain > finish_limit_;
   const cudaStream_t s = stream();
   const int key_bits = 2 * pair_bits_, task_bits = 32 + edge_bits_;
-  const uint64_t* keys = host_keys_.data();
-  const uint8_t* statuses = host_status_.data();
-  const uint64_t* tasks = host_uncertain_.data();
   if (large_pairs || large_tasks) {
     timer_.start(s);
     keys_alt_.reserve(std::max<size_t>(c.pairs, 1));
@@ -804,8 +845,6 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
                                       c.pairs * sizeof(uint64_t), cudaMemcpyDeviceToHost, s));
       SNAG_CUDA_CHECK(cudaMemcpyAsync(status_host_.data(), status_alt_.data(), c.pairs,
                                       cudaMemcpyDeviceToHost, s));
-      keys = keys_host_.data();
-      statuses = status_host_.data();
     }
     if (large_tasks) {
       uncertain_host_.reserve(c.uncertain);
@@ -815,29 +854,28 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
                                          static_cast<int64_t>(c.uncertain), 0, task_bits, s));
       SNAG_CUDA_CHECK(cudaMemcpyAsync(uncertain_host_.data(), tasks_alt_.data(),
                                       c.uncertain * sizeof(uint64_t), cudaMemcpyDeviceToHost, s));
-      tasks = uncertain_host_.data();
     }
     timer_.stop_async(s);
     times_.classify += timer_.elapsed();
   }
 
-  int64_t uncertain_kinds = 0;
-  frame.pairs.resize(c.pairs);
-  frame.kind_certain.resize(c.pairs);
-  const uint64_t mask = (uint64_t{1} << pair_bits_) - 1;
-  for (unsigned long long i = 0; i < c.pairs; ++i) {
-    const uint64_t key = keys[i];
-    const uint8_t status = statuses[i];
-    frame.pairs[i] = {static_cast<int32_t>(key >> pair_bits_), static_cast<int32_t>(key & mask),
-                      static_cast<detect::PairKind>(status & 1)};
-    frame.kind_certain[i] = static_cast<uint8_t>(status >> 1);
-    uncertain_kinds += 1 - (status >> 1);
-  }
-  frame.uncertain.resize(c.uncertain);
-  for (unsigned long long i = 0; i < c.uncertain; ++i) {
-    const uint64_t key = tasks[i];
-    frame.uncertain[i] = {static_cast<int32_t>(key >> 32), static_cast<int32_t>(key & 0xffffffffu)};
-  }
+  // A frame's results as finish_kernel wrote them (FilteredFrame's own types), or from the
+  // device-wide sorts' keys.
+  const auto pair_count = static_cast<size_t>(c.pairs);
+  const auto task_count = static_cast<size_t>(c.uncertain);
+  if (large_pairs)
+    decode_pairs(pair_count, frame, [&](size_t i) {
+      return std::pair<uint64_t, uint8_t>{keys_host_.data()[i], status_host_.data()[i]};
+    });
+  else
+    decode_pairs(pair_count, frame, [&](size_t i) {
+      const uint64_t packed = host_pairs_.data()[i];
+      return std::pair<uint64_t, uint8_t>{packed & ((uint64_t{1} << kStatusShift) - 1),
+                                          static_cast<uint8_t>(packed >> kStatusShift)};
+    });
+  decode_tasks(large_tasks ? uncertain_host_.data() : host_uncertain_.data(), task_count, frame);
+  const auto uncertain_kinds = static_cast<int64_t>(
+      std::count(frame.kind_certain.begin(), frame.kind_certain.end(), uint8_t{0}));
   frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) +
                          static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
   frame.classify_seconds = seconds_since(classify_start);

@@ -70,25 +70,42 @@ __device__ __forceinline__ void add_warp_total(unsigned long long value,
 /// in one launch where two memsets were two steps of the stream.
 __global__ void clear_frame_kernel(FrameCounters* counters, unsigned long long* table,
                                    unsigned long long table_size) {
+  wait_for_previous_kernel();
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   if (first == 0) *counters = FrameCounters{};
   for (unsigned long long i = first; i < table_size; i += stride) table[i] = kEmptyKey;
 }
 
+/// One thread per triangle; with `publish`, the last block to finish (a ticket) copies the
+/// counts there and leaves the counters zero for the next scan, so that a scan is one launch
+/// per part, with no memset ahead of it and no copy after.
 __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles,
                                        int32_t first, int32_t n, int32_t* degenerate,
-                                       int32_t* uncertain, FrameCounters* counters) {
+                                       int32_t* uncertain, ScanCounters* counters,
+                                       ScanCounts* publish) {
+  wait_for_previous_kernel();
   const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (i >= n) return;
-  const int32_t t = first + i;
-  const geom::FilteredPredicates pred{positions};
-  const geom::Tri tri = triangles[t];
-  const geom::Answer answer = geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]);
-  // Rare: a plain atomic per id.
-  if (answer == geom::Answer::yes) degenerate[atomicAdd(&counters->degenerate, 1ull)] = t;
-  if (answer == geom::Answer::uncertain)
-    uncertain[atomicAdd(&counters->degenerate_uncertain, 1ull)] = t;
+  if (i < n) {
+    const int32_t t = first + i;
+    const geom::FilteredPredicates pred{positions};
+    const geom::Tri tri = triangles[t];
+    const geom::Answer answer = geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]);
+    // Rare: a plain atomic per id.
+    if (answer == geom::Answer::yes) degenerate[atomicAdd(&counters->degenerate, 1ull)] = t;
+    if (answer == geom::Answer::uncertain) uncertain[atomicAdd(&counters->uncertain, 1ull)] = t;
+  }
+  if (!publish) return;
+  __shared__ bool last;
+  __threadfence();  // the block's counts are added before its ticket is
+  __syncthreads();
+  if (threadIdx.x == 0) last = atomicAdd(&counters->blocks_done, 1u) == gridDim.x - 1;
+  __syncthreads();
+  if (last && threadIdx.x == 0) {
+    publish->degenerate = atomicExch(&counters->degenerate, 0ull);
+    publish->uncertain = atomicExch(&counters->uncertain, 0ull);
+    counters->blocks_done = 0;
+  }
 }
 
 __global__ void flag_degenerate_kernel(const int32_t* list, int32_t count, uint8_t* degenerate) {
@@ -98,6 +115,7 @@ __global__ void flag_degenerate_kernel(const int32_t* list, int32_t count, uint8
 
 __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                               geom::PlaneCoefficients* planes) {
+  wait_for_previous_kernel();
   const int32_t t = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
@@ -160,6 +178,7 @@ class KeyLister {
 __global__ void __launch_bounds__(kNarrowBlock)
     self_walk_kernel(bvh::TreeView tree, int32_t base, int32_t first_unopened,
                      const uint8_t* degenerate, SubwalkList subwalks, FrameCounters* counters) {
+  wait_for_previous_kernel();
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   if (degenerate[base + tree.triangle_at[position]]) return;
@@ -175,6 +194,7 @@ __global__ void __launch_bounds__(kNarrowBlock)
     cross_walk_kernel(bvh::TreeView tree, int32_t base_a, bvh::TreeView other,
                       int32_t first_unopened, const uint8_t* degenerate, SubwalkList subwalks,
                       FrameCounters* counters) {
+  wait_for_previous_kernel();
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   if (degenerate[base_a + tree.triangle_at[position]]) return;
@@ -193,6 +213,7 @@ __global__ void __launch_bounds__(kNarrowBlock)
 __global__ void __launch_bounds__(kBlock)
     subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, SubwalkList subwalks,
                    CandidateList listed, FrameCounters* counters) {
+  wait_for_previous_kernel();
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long count = counters->subwalks;
@@ -247,6 +268,7 @@ __device__ __forceinline__ void for_each_listed_pair(const PairInputs& in,
 __global__ void __launch_bounds__(kBlock)
     deferred_test_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
                          CandidateList listed, ResultBuffers out) {
+  wait_for_previous_kernel();
   DeviceSink sink{out};
   for_each_listed_pair(in, walked, walked_base, listed, out.counters, [&](int32_t t, int32_t x) {
     detect::test_candidate_pair<detect::FilterUse::defer_all>(in.frame, in.topology, t, x, sink);
@@ -264,6 +286,7 @@ __global__ void __launch_bounds__(kBlock)
 __global__ void __launch_bounds__(kBlock)
     pair_screen_kernel(PairInputs in, bvh::TreeView walked, int32_t walked_base,
                        CandidateList listed, FrameCounters* counters) {
+  wait_for_previous_kernel();
   for_each_listed_pair(in, walked, walked_base, listed, counters, [&](int32_t t, int32_t x) {
     uint32_t t_shared, x_shared;
     detect::shared_corners(in.topology.triangles[t], in.topology.triangles[x], t_shared, x_shared);
@@ -276,6 +299,7 @@ __global__ void __launch_bounds__(kBlock)
 /// the list never overflows), striding over their count.
 __global__ void __launch_bounds__(kBlock)
     screened_test_kernel(PairInputs in, CandidateList listed, ResultBuffers out) {
+  wait_for_previous_kernel();
   DeviceSink sink{out};
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
@@ -329,6 +353,7 @@ __global__ void expand_kernel(const uint64_t* hits, unsigned long long hit_capac
                               FrameCounters* counters, const int32_t* offsets, const int32_t* faces,
                               const uint8_t* degenerate, int bits, const geom::Vec3d* positions,
                               const geom::Tri* triangles, PairSet set) {
+  wait_for_previous_kernel();
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long hit_items = 2 * min(counters->hits, hit_capacity);
@@ -401,6 +426,7 @@ __device__ void write_ranked(const uint64_t* keys, unsigned long long count, uns
 __global__ void __launch_bounds__(kFinishThreads)
     finish_kernel(const FrameCounters* counters, PairSet set, const uint64_t* uncertain,
                   unsigned long long uncertain_capacity, FinishScratch scratch, HostResults out) {
+  wait_for_previous_kernel();
   const unsigned long long limit = min(out.limit, kFinishLimit);
   if (blockIdx.z == 0) {
     const unsigned long long pairs = counters->pairs;
@@ -408,8 +434,7 @@ __global__ void __launch_bounds__(kFinishThreads)
     if (pairs > 0 && pairs <= limit && pairs <= set.pair_capacity)
       write_ranked(set.keys, pairs, scratch.ranks, scratch.tickets,
                    [&](unsigned long long i, uint64_t key, unsigned rank) {
-                     out.keys[rank] = key;
-                     out.status[rank] = set.status[i];
+                     out.pairs[rank] = key | uint64_t{set.status[i]} << kStatusShift;
                    });
   } else {
     const unsigned long long tasks = counters->uncertain;
@@ -427,16 +452,15 @@ void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
   // Four table slots per thread, at most 512 blocks: the table is 2^17 slots for most frames.
   const unsigned long long blocks =
       std::clamp<unsigned long long>((table_size + 4 * kBlock - 1) / (4 * kBlock), 1, 512);
-  clear_frame_kernel<<<static_cast<unsigned>(blocks), kBlock, 0, stream>>>(counters, table,
-                                                                           table_size);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(clear_frame_kernel, dim3(static_cast<unsigned>(blocks)), dim3(kBlock), stream,
+                 counters, table, table_size);
 }
 
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
                             int32_t n, int32_t* degenerate, int32_t* uncertain,
-                            FrameCounters* counters, cudaStream_t stream) {
-  launch(scan_degenerate_kernel, n, stream, positions, triangles, first, n, degenerate, uncertain,
-         counters);
+                            ScanCounters* counters, ScanCounts* publish, cudaStream_t stream) {
+  launch_chained_items(scan_degenerate_kernel, n, stream, positions, triangles, first, n,
+                       degenerate, uncertain, counters, publish);
 }
 
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
@@ -446,7 +470,7 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream) {
-  launch(planes_kernel, n, stream, positions, triangles, n, planes);
+  launch_chained_items(planes_kernel, n, stream, positions, triangles, n, planes);
 }
 
 namespace {
@@ -461,8 +485,7 @@ void launch_counted(void (*kernel)(Params...), unsigned long long bound, unsigne
   const unsigned long long needed = (bound + kBlock - 1) / kBlock;
   const auto blocks = static_cast<unsigned>(
       std::max<unsigned long long>(1, std::min<unsigned long long>(needed, max_blocks)));
-  kernel<<<blocks, kBlock, 0, stream>>>(static_cast<Params>(args)...);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(kernel, dim3(blocks), dim3(kBlock), stream, std::forward<Args>(args)...);
 }
 
 void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, int32_t walked_base,
@@ -503,9 +526,8 @@ void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(tree.shape));
-  self_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
-      tree, base, first_unopened, inputs.degenerate, subwalks, results.counters);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(self_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree, base,
+                 first_unopened, inputs.degenerate, subwalks, results.counters);
   launch_subwalks(tree, base, tree, subwalks, listed, results, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
@@ -516,9 +538,8 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
                         detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
-  cross_walk_kernel<<<walk_blocks(tree), kNarrowBlock, 0, stream>>>(
-      tree, base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(cross_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree,
+                 base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
   launch_subwalks(tree, base_a, other, subwalks, listed, results, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
@@ -540,9 +561,8 @@ void launch_finish(const FrameCounters* counters, const PairSet& set, const uint
                    const FinishScratch& scratch, const HostResults& out, cudaStream_t stream) {
   const auto slices = static_cast<unsigned>(std::clamp<unsigned long long>(
       (expected + kFinishThreads - 1) / kFinishThreads, 1, kFinishSlices));
-  finish_kernel<<<dim3(slices, slices, 2), kFinishThreads, 0, stream>>>(
-      counters, set, uncertain, uncertain_capacity, scratch, out);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(finish_kernel, dim3(slices, slices, 2), dim3(kFinishThreads), stream, counters,
+                 set, uncertain, uncertain_capacity, scratch, out);
 }
 
 }  // namespace snag::cuda

@@ -24,8 +24,6 @@ struct FrameCounters {
   unsigned long long candidates;  ///< candidate pairs tested
   unsigned long long misses;      ///< tests decided `no`
   unsigned long long expanded;    ///< sum over hits of the edge's face count: a bound on pairs
-  unsigned long long degenerate;  ///< scan: certainly degenerate triangles
-  unsigned long long degenerate_uncertain;  ///< scan: the filter cannot tell
   unsigned long long pairs;  ///< distinct face pairs the expansion kept (entries wanted in `pairs`)
   unsigned long long listed;         ///< the current check's walks: candidate pairs they listed
   unsigned long long subwalks;       ///< the current check's walks above the split level: the
@@ -35,6 +33,21 @@ struct FrameCounters {
   unsigned long long listed_most;    ///< the most any check of the frame listed (entries wanted
                                      ///< in the candidate list)
   unsigned long long subwalks_most;  ///< likewise for the subwalk list
+};
+
+/// The degenerate-triangle scan's counts on the device, zero between scans: the launch that
+/// ends a scan publishes them (ScanCounts) and zeroes them again.
+struct ScanCounters {
+  unsigned long long degenerate;  ///< certainly degenerate triangles
+  unsigned long long uncertain;   ///< the filter cannot tell
+  unsigned blocks_done;           ///< the publishing launch's blocks done (its ticket)
+};
+
+/// A scan's counts as published, in host memory mapped into the device's address space
+/// (written by the scan's last block, read by the host after the stream's sync).
+struct ScanCounts {
+  unsigned long long degenerate;
+  unsigned long long uncertain;
 };
 
 /// Where a check's walk lists its candidate pairs for the pair tests: (t << 32 | leaf) keys, t
@@ -76,14 +89,20 @@ inline constexpr unsigned long long kEmptyKey = ~0ull;
 
 /// Where finish_kernel puts a frame's results: host memory mapped into the device's address
 /// space (written by the kernel, read by the host after the stream's sync), at most
-/// `limit` pairs and `limit` uncertain tests; counters always.
+/// `limit` pairs and `limit` uncertain tests; counters always. Each pair is one 8-byte store,
+/// its key with its status in bits 62 and 63 (kStatusShift): the kernel's end waits for its
+/// writes to cross the bus, and the scattered stores of a key and of a status byte apart took
+/// most of its 13 us at 3K pairs (cuda/NOTES.md, v9).
 struct HostResults {
-  uint64_t* keys = nullptr;
-  uint8_t* status = nullptr;
+  uint64_t* pairs = nullptr;
   uint64_t* uncertain = nullptr;
   FrameCounters* counters = nullptr;
   unsigned long long limit = 0;
 };
+
+/// A pair's status (PairSet::status) above its key in HostResults::pairs: keys are below 2^62,
+/// (a << bits | b) with bits at most 31.
+inline constexpr int kStatusShift = 62;
 
 /// finish_kernel ranks at most kFinishLimit pairs (and as many uncertain tests), comparing
 /// every key with every other, kFinishThreads against kFinishThreads per block; frames with
@@ -121,18 +140,20 @@ struct PairInputs {
 };
 
 /// Zeroes *counters and fills the pair set's table (table_size slots) with kEmptyKey: the
-/// start of every detect run.
+/// start of every detect run. This launch and every other below is chained (launch_chained).
 void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
                         unsigned long long table_size, cudaStream_t stream);
 
 /// Degenerate-triangle scan of triangles [first, first + n): appends ids the filter finds
-/// degenerate to `degenerate` and ids it cannot decide to `uncertain` (both in any order),
-/// counting them in counters.
+/// degenerate to `degenerate` and ids it cannot decide to `uncertain` (both in any order, after
+/// those of earlier launches of the same scan), counting them in `counters`. A scan of several
+/// parts is a launch per part; its last launch gives `publish`, where the counts go, and leaves
+/// `counters` zero (the others give nullptr). No launch ahead of a scan clears anything.
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
                             int32_t n, int32_t* degenerate, int32_t* uncertain,
-                            FrameCounters* counters, cudaStream_t stream);
+                            ScanCounters* counters, ScanCounts* publish, cudaStream_t stream);
 
-/// Sets degenerate[list[i]] = 1.
+/// Sets degenerate[list[i]] = 1 (an ordinary launch: it follows a copy).
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
                             cudaStream_t stream);
 

@@ -205,6 +205,7 @@ __global__ void __launch_bounds__(kRefitThreads)
                           int32_t top, unsigned* ticket) {
   __shared__ RefitLevels levels;
   __shared__ bool last;
+  wait_for_previous_kernel();
   // The block's subtree: its deepest level (all leaves) needs no `below`.
   fit_subtree_levels(tree, mesh, planes, top, static_cast<int32_t>(blockIdx.x), tree.shape.depth,
                      levels.narrow, levels.wide);
@@ -248,6 +249,7 @@ __global__ void __launch_bounds__(kQualityThreads)
   static_assert(bvh::kQualityLanes == 32, "a block's lanes are one warp's threads");
   __shared__ double areas[bvh::kQualityBlock];
   __shared__ bool last;
+  wait_for_previous_kernel();
   const int32_t block = static_cast<int32_t>(blockIdx.x);
   const int32_t begin = block * bvh::kQualityBlock;
   const int32_t count = bvh::quality_block_size(shape, block);
@@ -346,9 +348,8 @@ void DeviceTree::refit(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cud
   const bvh::TreeView tree = view();
   if (!level_by_level_refit) {
     const int32_t top = std::max(0, shape_.depth - kRefitLevels);
-    refit_subtrees_kernel<<<1u << top, kRefitThreads, 0, stream>>>(tree, mesh, planes, top,
-                                                                   refit_ticket_.data());
-    SNAG_CUDA_CHECK_LAUNCH();
+    launch_chained(refit_subtrees_kernel, dim3(1u << top), dim3(kRefitThreads), stream, tree, mesh,
+                   planes, top, refit_ticket_.data());
     return;
   }
   launch(refit_leaves_kernel, n, stream, tree, mesh, planes);
@@ -365,9 +366,9 @@ void DeviceTree::queue_quality(cudaStream_t stream) {
     *quality_host_.data() = 0.0;
     return;
   }
-  quality_kernel<<<static_cast<unsigned>(blocks), kQualityThreads, 0, stream>>>(
-      boxes_.data(), shape_, blocks, quality_blocks_.data(), quality_ticket_.data(), quality_out_);
-  SNAG_CUDA_CHECK_LAUNCH();
+  launch_chained(quality_kernel, dim3(static_cast<unsigned>(blocks)), dim3(kQualityThreads), stream,
+                 boxes_.data(), shape_, blocks, quality_blocks_.data(), quality_ticket_.data(),
+                 quality_out_);
 }
 
 double DeviceTree::quality(cudaStream_t stream) {
