@@ -145,7 +145,8 @@ class CudaBackendImpl final : public CudaBackend {
       check_timers_.push_back(std::make_unique<EventTimer>());
     ensure_result_capacity(initial_capacity_, initial_capacity_, initial_capacity_,
                            initial_capacity_, initial_capacity_, initial_capacity_);
-    subwalks_expected_ = expand_expected_ = static_cast<uint64_t>(initial_capacity_);
+    subwalks_expected_ = screened_expected_ = expand_expected_ =
+        static_cast<uint64_t>(initial_capacity_);
     finish_expected_ = kFinishLimit;
     stream_->synchronize();
   }
@@ -497,6 +498,7 @@ class CudaBackendImpl final : public CudaBackend {
                            grown(c.expanded + c.duplicates), grown(c.listed_most),
                            grown(c.subwalks_most));
     subwalks_expected_ = grown(c.subwalks_most);
+    screened_expected_ = grown(c.screened_most);
     expand_expected_ = grown(2 * c.hits + c.duplicates);
     // Any count fits the ranking's grid (it strides), but a grid much too small ranks slowly:
     // sized for the larger of this frame's count and seven eighths of what it was sized for,
@@ -614,6 +616,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint64_t> subwalks_;  // a check's walks under the split level, from the walks
                                      // above it to the subwalk kernel
   uint64_t subwalks_expected_ = 1;   // the last frame's most subwalks, with slack
+  uint64_t screened_expected_ = 1;   // its most screened pairs, with slack
   uint64_t expand_expected_ = 1;     // its expansion's items (two per hit), with slack
   uint64_t finish_expected_ = 1;     // its pairs or uncertain tests, the more (see fit_counts)
   DeviceBuffer<uint64_t> hits_, uncertain_, duplicates_;
@@ -697,7 +700,8 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   results.edge_face_offsets = topo_.edge_face_offsets.data();
   PairSet set{table_.data(), table_.capacity() - 1, pair_keys_.data(), pair_status_.data(),
               pair_keys_.capacity()};
-  const CandidateList listed{listed_.data(), candidate_capacity(), screened_.data()};
+  const CandidateList listed{listed_.data(), candidate_capacity(), screened_.data(),
+                             screened_expected_};
   const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
   HostResults out = host_results_;
   out.limit = finish_limit_;

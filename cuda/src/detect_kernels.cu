@@ -296,7 +296,8 @@ __global__ void __launch_bounds__(kBlock)
 }
 
 /// The whole pair test of each pair the screen kept (at most one per listed pair stored, so
-/// the list never overflows), striding over their count.
+/// the list never overflows), on a grid for the count expected (CandidateList::
+/// screened_expected), striding over the count.
 __global__ void __launch_bounds__(kBlock)
     screened_test_kernel(PairInputs in, CandidateList listed, ResultBuffers out) {
   wait_for_previous_kernel();
@@ -304,6 +305,7 @@ __global__ void __launch_bounds__(kBlock)
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long count = out.counters->screened;
+  if (first == 0) atomicMax(&out.counters->screened_most, count);
   for (unsigned long long i = first; i < count; i += stride) {
     const uint64_t pair = listed.screened[i];
     detect::test_candidate_pair(in.frame, in.topology, static_cast<int32_t>(pair >> 32),
@@ -492,10 +494,16 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (use == detect::FilterUse::certify) {
-    launch_counted(pair_screen_kernel, listed.capacity, max_blocks, stream, inputs, walked,
+    // The screen's pairs cost about the same each: one wave of its blocks, striding, rather
+    // than a second wave queued behind the first (62 registers: four blocks per SM, not the
+    // eight of max_blocks). 36K triangles: 6 us less (cuda/NOTES.md, v9). The tests, whose
+    // pairs vary widely, keep waves: a block that finishes early takes more.
+    const unsigned screen_blocks = std::min(
+        max_blocks, resident_blocks(reinterpret_cast<const void*>(&pair_screen_kernel), kBlock));
+    launch_counted(pair_screen_kernel, listed.capacity, screen_blocks, stream, inputs, walked,
                    walked_base, listed, results.counters);
-    launch_counted(screened_test_kernel, listed.capacity, max_blocks, stream, inputs, listed,
-                   results);
+    launch_counted(screened_test_kernel, std::min(listed.screened_expected, listed.capacity),
+                   max_blocks, stream, inputs, listed, results);
   } else
     launch_counted(deferred_test_kernel, listed.capacity, max_blocks, stream, inputs, walked,
                    walked_base, listed, results);

@@ -33,6 +33,7 @@ struct FrameCounters {
   unsigned long long listed_most;    ///< the most any check of the frame listed (entries wanted
                                      ///< in the candidate list)
   unsigned long long subwalks_most;  ///< likewise for the subwalk list
+  unsigned long long screened_most;  ///< the most pairs any check's screen kept
 };
 
 /// The degenerate-triangle scan's counts on the device, zero between scans: the launch that
@@ -59,6 +60,10 @@ struct CandidateList {
   /// The (t << 32 | x) pairs that pass the screen (detect::pair_passes_sides), as many slots
   /// as `pairs`: at most every pair stored there passes.
   uint64_t* screened = nullptr;
+  /// What the whole test's grid is sized for: the last frame's most screened pairs, with slack.
+  /// A grid for the capacity, as the screen's, was mostly idle blocks: a settled cloth keeps
+  /// about one listed pair in ten.
+  unsigned long long screened_expected = 0;
 };
 
 /// Where a check's walks above the split level (bvh::split_walk_level) hand over the rest of
@@ -180,8 +185,9 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// each time), and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`), in one pair
 /// test kernel of its own: it computes no sides to screen with. The subwalks run one per
-/// thread; the pair tests on at most `max_blocks` blocks (striding over their list when
-/// longer).
+/// thread; the screen on one wave of its blocks (at most `max_blocks`) striding over the list,
+/// and the whole test on a grid for the pairs expected (CandidateList::screened_expected, at
+/// most `max_blocks` blocks) striding over the pairs kept.
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
                        const SubwalkList& subwalks, const CandidateList& listed,
                        const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,

@@ -1,6 +1,10 @@
 #include "launch.cuh"
 
+#include <algorithm>
 #include <atomic>
+#include <mutex>
+#include <tuple>
+#include <vector>
 
 namespace snag::cuda {
 
@@ -27,6 +31,29 @@ bool chained_launches_supported() {
   const bool yes = major >= 9 && probe.ptxVersion >= 90 && probe.binaryVersion >= 90;
   answers[device].store(yes ? 2 : 1, std::memory_order_relaxed);
   return yes;
+}
+
+unsigned resident_blocks(const void* kernel, int block_threads) {
+  struct Known {
+    int device;
+    const void* kernel;
+    int block_threads;
+    unsigned blocks;
+  };
+  static std::mutex mutex;
+  static std::vector<Known> known;
+  int device = 0;
+  SNAG_CUDA_CHECK(cudaGetDevice(&device));
+  const std::lock_guard lock(mutex);
+  for (const Known& k : known)
+    if (std::tie(k.device, k.kernel, k.block_threads) == std::tie(device, kernel, block_threads))
+      return k.blocks;
+  int per_sm = 0, sms = 0;
+  SNAG_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device));
+  SNAG_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, kernel, block_threads, 0));
+  const auto blocks = static_cast<unsigned>(std::max(per_sm, 1) * std::max(sms, 1));
+  known.push_back({device, kernel, block_threads, blocks});
+  return blocks;
 }
 
 }  // namespace snag::cuda

@@ -35,6 +35,11 @@ void launch(void (*kernel)(Params...), int64_t count, cudaStream_t stream, Args&
 /// would let it read its predecessor's results early. Asked of the driver once per device.
 bool chained_launches_supported();
 
+/// How many blocks of `kernel`, `block_threads` threads each, the current device runs at once:
+/// its SMs times the kernel's occupancy (registers, shared memory). Asked of the driver once per
+/// kernel and device.
+unsigned resident_blocks(const void* kernel, int block_threads);
+
 /// Launches `kernel` on `stream` allowed to start before the kernel ahead of it there has
 /// finished (programmatic stream serialization): its blocks are scheduled while the previous
 /// kernel's last blocks run, and each waits in wait_for_previous_kernel() until that kernel has
