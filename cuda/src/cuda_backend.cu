@@ -490,7 +490,8 @@ class CudaBackendImpl final : public CudaBackend {
   /// With some slack, so that a sequence whose counts creep up does not run every frame twice.
   static uint64_t grown(uint64_t count) { return count + count / 2 + 1024; }
 
-  /// Buffers for a run's counts with slack (grown), and the subwalk grid sized for them. Growing
+  /// Buffers for a run's counts with slack (grown), and the grids of the subwalks, the whole
+  /// pair tests, the expansion and the ranking sized for them. Growing
   /// discards the buffers' contents: after a frame's results are read, or before a run again.
   void fit_counts(const FrameCounters& c) {
     // c.expanded + c.duplicates bounds the pairs of every stored hit.
@@ -863,8 +864,8 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     times_.classify += timer_.elapsed();
   }
 
-  // A frame's results as finish_kernel wrote them (FilteredFrame's own types), or from the
-  // device-wide sorts' keys.
+  // A frame's results as finish_kernel wrote them (pairs with their status above the key), or
+  // the device-wide sorts' keys and statuses.
   const auto pair_count = static_cast<size_t>(c.pairs);
   const auto task_count = static_cast<size_t>(c.uncertain);
   if (large_pairs)

@@ -96,8 +96,8 @@ inline constexpr unsigned long long kEmptyKey = ~0ull;
 /// space (written by the kernel, read by the host after the stream's sync), at most
 /// `limit` pairs and `limit` uncertain tests; counters always. Each pair is one 8-byte store,
 /// its key with its status in bits 62 and 63 (kStatusShift): the kernel's end waits for its
-/// writes to cross the bus, and the scattered stores of a key and of a status byte apart took
-/// most of its 13 us at 3K pairs (cuda/NOTES.md, v9).
+/// writes to cross the bus, and with the scattered stores of a key and of a status byte apart
+/// it took 13.6 us at 3K pairs, 10.4 us now (cuda/NOTES.md, v9).
 struct HostResults {
   uint64_t* pairs = nullptr;
   uint64_t* uncertain = nullptr;
@@ -145,7 +145,8 @@ struct PairInputs {
 };
 
 /// Zeroes *counters and fills the pair set's table (table_size slots) with kEmptyKey: the
-/// start of every detect run. This launch and every other below is chained (launch_chained).
+/// start of every detect run. This launch and every other below but launch_flag_degenerate's is
+/// chained (launch_chained).
 void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
                         unsigned long long table_size, cudaStream_t stream);
 
