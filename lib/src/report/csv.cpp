@@ -46,10 +46,10 @@ std::string_view frames_csv_header_for(std::span<const ObjectInput> objects) {
   return objects.empty() ? frames_csv_header : scene_frames_csv_header;
 }
 
-void write_pairs_rows(std::ostream& out, const FrameRecord& f,
-                      std::span<const ObjectInput> objects) {
-  // std::to_chars into a line buffer: a 100K-pair frame is written in milliseconds, and the
-  // bytes do not depend on the stream's locale or flags.
+void append_pairs_rows(std::string& out, const FrameRecord& f,
+                       std::span<const ObjectInput> objects) {
+  // std::to_chars into a line buffer, each line appended to `out`: a 100K-pair frame is
+  // written in milliseconds, and the bytes do not depend on a stream's locale or flags.
   char line[128];
   char* const after_frame = std::to_chars(line, line + 24, f.frame).ptr;
   *after_frame = ',';
@@ -58,7 +58,8 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f,
   std::vector<std::string> names;
   names.reserve(objects.size());
   for (const ObjectInput& o : objects) names.push_back(csv_field(o.name));
-  std::string row;
+  // About 36 bytes a row of a single mesh: one growth of `out` at most, for most frames.
+  out.reserve(out.size() + f.pairs.size() * (names.empty() ? 40 : 64));
   const auto write_row = [&](const Pair& p) {
     char* q = after_frame + 1;
     q = std::to_chars(q, q + 12, p.a).ptr;
@@ -72,16 +73,15 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f,
     q = std::to_chars(q, q + 12, p.poly_b).ptr;
     if (names.empty()) {
       *q++ = '\n';
-      out.write(line, q - line);
+      out.append(line, q);
       return;
     }
-    row.assign(line, q);
-    row += ',';
-    row += pair_object_name(names, f, p, p.object_a);
-    row += ',';
-    row += pair_object_name(names, f, p, p.object_b);
-    row += '\n';
-    out.write(row.data(), static_cast<std::streamsize>(row.size()));
+    out.append(line, q);
+    out += ',';
+    out += pair_object_name(names, f, p, p.object_a);
+    out += ',';
+    out += pair_object_name(names, f, p, p.object_b);
+    out += '\n';
   };
   // Records are sorted by construction (make_frame_record); only a record built otherwise
   // pays for a sorted copy of pointers, one frame's worth.
@@ -95,6 +95,13 @@ void write_pairs_rows(std::ostream& out, const FrameRecord& f,
   std::sort(sorted.begin(), sorted.end(),
             [&](const Pair* x, const Pair* y) { return pair_order(*x, *y); });
   for (const Pair* p : sorted) write_row(*p);
+}
+
+void write_pairs_rows(std::ostream& out, const FrameRecord& f,
+                      std::span<const ObjectInput> objects) {
+  std::string rows;
+  append_pairs_rows(rows, f, objects);
+  out.write(rows.data(), static_cast<std::streamsize>(rows.size()));
 }
 
 void write_frames_row(std::ostream& out, const FrameRecord& f,

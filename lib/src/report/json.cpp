@@ -219,7 +219,9 @@ std::string json_file_element(const std::string& file, bool first) {
 /// array's member line is indented `level` times. Written by hand: a frame can have millions
 /// of pairs, and building a JSON object per pair cost more than checking the frame.
 /// `names`: the scene's object names as JSON strings (json_string), empty for a single mesh.
-std::string pairs_array(const FrameRecord& f, int level, std::span<const std::string> names) {
+/// Appended to `out`.
+void append_pairs_array(std::string& out, const FrameRecord& f, int level,
+                        std::span<const std::string> names) {
   const std::vector<Pair>& pairs = f.pairs;
   const std::string object_margin = indent(level + 1), member_margin = indent(level + 2);
   const bool scene = !names.empty();
@@ -237,8 +239,9 @@ std::string pairs_array(const FrameRecord& f, int level, std::span<const std::st
   const std::string before_object_a = member_break + "\"object_a\": ";
   const std::string before_object_b = member_break + "\"object_b\": ";
   const std::string close = "\n" + object_margin + "}";
-  std::string out = "[";
-  out.reserve(pairs.size() * ((scene ? 8 : 6) * member_margin.size() + (scene ? 160 : 96)));
+  out.reserve(out.size() +
+              pairs.size() * ((scene ? 8 : 6) * member_margin.size() + (scene ? 160 : 96)));
+  out += '[';
   char number[16];
   const auto add_number = [&](int32_t value) {
     const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
@@ -267,13 +270,15 @@ std::string pairs_array(const FrameRecord& f, int level, std::span<const std::st
     out += indent(level);
   }
   out += ']';
-  return out;
 }
 
-std::string json_frame_element(const FrameRecord& frame, bool first,
+void append_json_frame_element(std::string& out, const FrameRecord& frame, bool first,
                                std::span<const ObjectInput> objects) {
-  std::string text = array_element(frame_json(frame, objects), frames_level, first);
-  if (frame.pairs.empty()) return text;
+  const std::string text = array_element(frame_json(frame, objects), frames_level, first);
+  if (frame.pairs.empty()) {
+    out += text;
+    return;
+  }
   // The record's members sit two levels inside the frames array's line; its "pairs" member
   // is the only one at that indentation whose value is [] (a string value cannot hold an
   // unescaped quote, so no file or object name can look like it; the scene members' own
@@ -290,7 +295,18 @@ std::string json_frame_element(const FrameRecord& frame, bool first,
   std::vector<std::string> names;
   names.reserve(objects.size());
   for (const ObjectInput& o : objects) names.push_back(json_string(o.name));
-  text.replace(at + placeholder.size() - 2, 2, pairs_array(frame, member_level, names));
+  // The record up to its "pairs" member's value, the pairs, then the rest: no copy of the
+  // record with the pairs in it.
+  const size_t value_at = at + placeholder.size() - 2;
+  out.append(text, 0, value_at);
+  append_pairs_array(out, frame, member_level, names);
+  out.append(text, value_at + 2);
+}
+
+std::string json_frame_element(const FrameRecord& frame, bool first,
+                               std::span<const ObjectInput> objects) {
+  std::string text;
+  append_json_frame_element(text, frame, first, objects);
   return text;
 }
 

@@ -24,6 +24,10 @@ std::string json_file_element(const std::string& file, bool first);
 /// one per object, throws InternalError.
 std::string json_frame_element(const FrameRecord& frame, bool first,
                                std::span<const ObjectInput> objects);
+/// json_frame_element's text appended to `out`, a buffer the caller can keep from frame to frame
+/// (ReportStream's writer does).
+void append_json_frame_element(std::string& out, const FrameRecord& frame, bool first,
+                               std::span<const ObjectInput> objects);
 
 /// Writes report.json: `run`'s head (version, settings), the frames elements `write_frames`
 /// writes (what json_frame_element gave, in order), then the inputs with the inputs.files

@@ -100,10 +100,16 @@ void ReportStream::write_loop() {
 }
 
 void ReportStream::write_frame(const FrameRecord& frame, bool first) {
-  write_pairs_rows(files_->pairs_csv.out(), frame, objects_);
+  const auto write = [&](StagedFile& file) {
+    file.out().write(text_.data(), static_cast<std::streamsize>(text_.size()));
+    text_.clear();  // its capacity stays for the next frame
+  };
+  append_pairs_rows(text_, frame, objects_);
+  write(files_->pairs_csv);
   write_frames_row(files_->frames_csv.out(), frame, objects_);
   files_->file_names.out() << json_file_element(frame.file, first);
-  files_->report_json.out() << json_frame_element(frame, first, objects_);
+  append_json_frame_element(text_, frame, first, objects_);
+  write(files_->report_json);
   for (const StagedFile* f :
        {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->report_json})
     f->check();

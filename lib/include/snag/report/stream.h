@@ -92,6 +92,9 @@ class ReportStream {
   SummaryAccumulator accumulator_;
   std::optional<int64_t> last_frame_;
   std::unique_ptr<Files> files_;
+  /// The writer thread's text of a frame's rows, then of its record (~450 KB of report.json for
+  /// 3K pairs), each written at once; kept from frame to frame rather than allocated for each.
+  std::string text_;
   bool finished_ = false;
 
   // The writer thread and the frames handed to it (only with an output directory).
