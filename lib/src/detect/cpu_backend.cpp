@@ -361,24 +361,27 @@ class CpuBackend final : public Backend {
   /// dynamic chunks of 256 leaves.
   template <GroupWalk kind, FilterUse use>
   void walk_groups(const WalkInput& in, ThreadSink& sink) const {
+    if (wide_)
+      walk_groups_of<8, kind, use>(in, sink);
+    else
+      walk_groups_of<4, kind, use>(in, sink);
+  }
+
+  template <int W, GroupWalk kind, FilterUse use>
+  void walk_groups_of(const WalkInput& in, ThreadSink& sink) const {
     int32_t first_group, last_group;
-    if (wide_) {
-      bvh::group_range<8>(in.tree.shape, first_group, last_group);
-#pragma omp for schedule(dynamic, 32)
-      for (int32_t group = first_group; group < last_group; ++group) {
+    bvh::group_range<W>(in.tree.shape, first_group, last_group);
+#pragma omp for schedule(dynamic, 256 / W)
+    for (int32_t group = first_group; group < last_group; ++group) {
 #if defined(SNAG_HAVE_AVX2_WALK)
+      if constexpr (W == 8) {
         if (avx2_) {
           walk_group_avx2<kind, use>(in, group, sink);
           continue;
         }
-#endif
-        walk_group<kind, 8, use>(in, group, sink);
       }
-    } else {
-      bvh::group_range<4>(in.tree.shape, first_group, last_group);
-#pragma omp for schedule(dynamic, 64)
-      for (int32_t group = first_group; group < last_group; ++group)
-        walk_group<kind, 4, use>(in, group, sink);
+#endif
+      walk_group<kind, W, use>(in, group, sink);
     }
   }
 
