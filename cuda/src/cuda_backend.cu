@@ -48,7 +48,7 @@ struct SelectDevice {
 
 class CudaBackendImpl final : public CudaBackend {
  public:
-  explicit CudaBackendImpl(int device) : select_(device), device_(device) {
+  explicit CudaBackendImpl(int device) : select_(device) {
     cudaDeviceProp prop{};
     SNAG_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
     device_name_ = prop.name;
@@ -61,11 +61,13 @@ class CudaBackendImpl final : public CudaBackend {
     counters_host_.reserve(1);
     scan_counters_.reserve(1);
     scan_counts_host_.reserve(1);
-    SNAG_CUDA_CHECK(cudaMemset(scan_counters_.data(), 0, sizeof(ScanCounters)));
+    SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), stream()));
     finish_ranks_.reserve(2 * kFinishLimit);
     finish_tickets_.reserve(2 * kFinishSlices);
-    SNAG_CUDA_CHECK(cudaMemset(finish_ranks_.data(), 0, 2 * kFinishLimit * sizeof(unsigned)));
-    SNAG_CUDA_CHECK(cudaMemset(finish_tickets_.data(), 0, 2 * kFinishSlices * sizeof(unsigned)));
+    SNAG_CUDA_CHECK(
+        cudaMemsetAsync(finish_ranks_.data(), 0, 2 * kFinishLimit * sizeof(unsigned), stream()));
+    SNAG_CUDA_CHECK(
+        cudaMemsetAsync(finish_tickets_.data(), 0, 2 * kFinishSlices * sizeof(unsigned), stream()));
   }
 
   ~CudaBackendImpl() override {
@@ -126,10 +128,9 @@ class CudaBackendImpl final : public CudaBackend {
       positions_host_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
     }
     current_positions_ = positions_[positions_slot_].data();
-    pair_bits_ = bits_for(d.triangle_count);  // at most 31: keys leave HostResults' status bits
-    if (2 * pair_bits_ > kStatusShift)
-      throw InternalError("cuda backend: " + std::to_string(d.triangle_count) +
-                          " triangles do not fit the pair keys");
+    // At most 31 (triangle ids are int32): pair keys leave HostResults' status bits free.
+    static_assert(2 * 31 <= kStatusShift);
+    pair_bits_ = bits_for(d.triangle_count);
     edge_bits_ = bits_for(d.edge_count);
     // One tree per part, and what each part's device data fits (PartState).
     const int32_t parts = topology.part_count();
@@ -261,8 +262,9 @@ class CudaBackendImpl final : public CudaBackend {
       if (part_size(parts[i]) > 0)
         launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(parts[i]),
                                part_size(parts[i]), mapped(scan_degenerate_host_.data()),
-                               mapped(scan_uncertain_host_.data()), scan_counters_.data(),
-                               i == last_scanned ? mapped(counts) : nullptr, s);
+                               mapped(scan_uncertain_host_.data()), topo_.triangle_count,
+                               scan_counters_.data(), i == last_scanned ? mapped(counts) : nullptr,
+                               s);
     std::vector<int32_t> ahead;
     for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
       if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
@@ -280,6 +282,16 @@ class CudaBackendImpl final : public CudaBackend {
       part_[p].quality_ready = true;
     }
     const ScanCounts c = *counts;
+    int64_t scanned = 0;
+    for (int32_t p : parts) scanned += part_size(p);
+    if (c.degenerate + c.uncertain > static_cast<unsigned long long>(scanned)) {
+      // Counters left non-zero (a scan cut short): zeroed for the next scan, this one lost.
+      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), s));
+      stream_->synchronize();
+      throw InternalError("cuda backend: the degenerate-triangle scan counted " +
+                          std::to_string(c.degenerate + c.uncertain) + " of " +
+                          std::to_string(scanned) + " triangles");
+    }
     scan.degenerate.assign(scan_degenerate_host_.data(),
                            scan_degenerate_host_.data() + c.degenerate);
     scan.uncertain.assign(scan_uncertain_host_.data(), scan_uncertain_host_.data() + c.uncertain);
@@ -570,7 +582,6 @@ class CudaBackendImpl final : public CudaBackend {
   };
 
   SelectDevice select_;
-  int device_;
   std::string device_name_;
   std::unique_ptr<Stream> stream_;
   EventTimer timer_, span_timer_;

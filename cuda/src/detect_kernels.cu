@@ -82,7 +82,7 @@ __global__ void clear_frame_kernel(FrameCounters* counters, unsigned long long* 
 /// per part, with no memset ahead of it and no copy after.
 __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom::Tri* triangles,
                                        int32_t first, int32_t n, int32_t* degenerate,
-                                       int32_t* uncertain, ScanCounters* counters,
+                                       int32_t* uncertain, int32_t capacity, ScanCounters* counters,
                                        ScanCounts* publish) {
   wait_for_previous_kernel();
   const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
@@ -91,9 +91,16 @@ __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom:
     const geom::FilteredPredicates pred{positions};
     const geom::Tri tri = triangles[t];
     const geom::Answer answer = geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]);
-    // Rare: a plain atomic per id.
-    if (answer == geom::Answer::yes) degenerate[atomicAdd(&counters->degenerate, 1ull)] = t;
-    if (answer == geom::Answer::uncertain) uncertain[atomicAdd(&counters->uncertain, 1ull)] = t;
+    // Rare: a plain atomic per id. Within `capacity` whatever the counters held before (the
+    // host checks the counts it reads).
+    if (answer == geom::Answer::yes) {
+      const unsigned long long at = atomicAdd(&counters->degenerate, 1ull);
+      if (at < static_cast<unsigned long long>(capacity)) degenerate[at] = t;
+    }
+    if (answer == geom::Answer::uncertain) {
+      const unsigned long long at = atomicAdd(&counters->uncertain, 1ull);
+      if (at < static_cast<unsigned long long>(capacity)) uncertain[at] = t;
+    }
   }
   if (!publish) return;
   __shared__ bool last;
@@ -102,6 +109,7 @@ __global__ void scan_degenerate_kernel(const geom::Vec3d* positions, const geom:
   if (threadIdx.x == 0) last = atomicAdd(&counters->blocks_done, 1u) == gridDim.x - 1;
   __syncthreads();
   if (last && threadIdx.x == 0) {
+    __threadfence();  // every other block's counts are read after its ticket
     publish->degenerate = atomicExch(&counters->degenerate, 0ull);
     publish->uncertain = atomicExch(&counters->uncertain, 0ull);
     counters->blocks_done = 0;
@@ -459,10 +467,10 @@ void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
 }
 
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
-                            int32_t n, int32_t* degenerate, int32_t* uncertain,
+                            int32_t n, int32_t* degenerate, int32_t* uncertain, int32_t capacity,
                             ScanCounters* counters, ScanCounts* publish, cudaStream_t stream) {
   launch_chained_items(scan_degenerate_kernel, n, stream, positions, triangles, first, n,
-                       degenerate, uncertain, counters, publish);
+                       degenerate, uncertain, capacity, counters, publish);
 }
 
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,

@@ -152,11 +152,12 @@ void launch_clear_frame(FrameCounters* counters, unsigned long long* table,
 
 /// Degenerate-triangle scan of triangles [first, first + n): appends ids the filter finds
 /// degenerate to `degenerate` and ids it cannot decide to `uncertain` (both in any order, after
-/// those of earlier launches of the same scan), counting them in `counters`. A scan of several
-/// parts is a launch per part; its last launch gives `publish`, where the counts go, and leaves
-/// `counters` zero (the others give nullptr). No launch ahead of a scan clears anything.
+/// those of earlier launches of the same scan; each array holds `capacity` ids, and a count past
+/// it is left for the host to see), counting them in `counters`. A scan of several parts is a
+/// launch per part; its last launch gives `publish`, where the counts go, and leaves `counters`
+/// zero (the others give nullptr). No launch ahead of a scan clears anything.
 void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t first,
-                            int32_t n, int32_t* degenerate, int32_t* uncertain,
+                            int32_t n, int32_t* degenerate, int32_t* uncertain, int32_t capacity,
                             ScanCounters* counters, ScanCounts* publish, cudaStream_t stream);
 
 /// Sets degenerate[list[i]] = 1 (an ordinary launch: it follows a copy).

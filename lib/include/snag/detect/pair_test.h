@@ -129,6 +129,20 @@ SNAG_HD_INLINE void sides_against(const geom::Vec3d* positions,
   }
 }
 
+/// The rejection by sides of the pair (t, x) (triangles tt, xt; shared corners t_shared,
+/// x_shared): true when all of one triangle's corners not shared with the other lie strictly on
+/// one side of the other's plane, so that the two cannot meet beyond their shared corners. Fills
+/// side_t (t's corners against x's plane) and, when t's are not separated, side_x.
+SNAG_HD_INLINE bool separated_by_sides(const FrameView& frame, int32_t t, const geom::Tri& tt,
+                                       uint32_t t_shared, int32_t x, const geom::Tri& xt,
+                                       uint32_t x_shared, geom::Sign side_t[3],
+                                       geom::Sign side_x[3]) {
+  sides_against(frame.positions, frame.planes[x], tt, t_shared, xt, side_t);
+  if (separated(side_t, t_shared)) return true;
+  sides_against(frame.positions, frame.planes[t], xt, x_shared, tt, side_x);
+  return separated(side_x, x_shared);
+}
+
 /// The narrow phase of the candidate pair (t, x), neither degenerate, whose shared corners
 /// are known (t_shared, x_shared: see shared_corners). Reports to `sink`:
 ///   hit(edge, triangle)       an edge meets a triangle beyond their shared endpoints: every
@@ -147,10 +161,7 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
     return;
   }
   geom::Sign side_t[3], side_x[3];
-  sides_against(frame.positions, frame.planes[x], tt, t_shared, xt, side_t);
-  if (separated(side_t, t_shared)) return;
-  sides_against(frame.positions, frame.planes[t], xt, x_shared, tt, side_x);
-  if (separated(side_x, x_shared)) return;
+  if (separated_by_sides(frame, t, tt, t_shared, x, xt, x_shared, side_t, side_x)) return;
   const uint8_t owned_t = topo.owned_edges[t], owned_x = topo.owned_edges[x];
   const geom::FilteredPredicates pred{frame.positions};
   if (owned_t) test_owned_edges(pred, topo, t, tt, owned_t, t_shared, x, xt, side_t, sink);
@@ -159,17 +170,14 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
 
 /// Whether test_pair_given_shared(frame, topo, t, x, t_shared, x_shared, ...) gets past the
 /// rejection by sides, so that it has anything to report: false exactly when it returns after
-/// the sides with no report. The same sides, computed the same way, so a GPU can screen its
-/// pairs with it in a light kernel and hand only the rest to the full test.
+/// the sides with no report (the same separated_by_sides), so a GPU can screen its pairs with
+/// it in a light kernel and hand only the rest to the full test.
 SNAG_HD_INLINE bool pair_passes_sides(const FrameView& frame, const TopologyView& topo, int32_t t,
                                       int32_t x, uint32_t t_shared, uint32_t x_shared) {
   if (t_shared == 7u) return true;  // a duplicated face: reported as one
-  const geom::Tri tt = topo.triangles[t], xt = topo.triangles[x];
-  geom::Sign side[3];
-  sides_against(frame.positions, frame.planes[x], tt, t_shared, xt, side);
-  if (separated(side, t_shared)) return false;
-  sides_against(frame.positions, frame.planes[t], xt, x_shared, tt, side);
-  return !separated(side, x_shared);
+  geom::Sign side_t[3], side_x[3];
+  return !separated_by_sides(frame, t, topo.triangles[t], t_shared, x, topo.triangles[x],
+                             x_shared, side_t, side_x);
 }
 
 /// The narrow phase of (t, x) with the filter left out (`--exact all`): every edge-triangle
