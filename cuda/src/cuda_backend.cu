@@ -57,11 +57,13 @@ class CudaBackendImpl final : public CudaBackend {
     max_blocks_ = static_cast<unsigned>(std::max(prop.multiProcessorCount, 1)) * 8u;
     stream_ = std::make_unique<Stream>();
     upload_stream_ = std::make_unique<Stream>();
+    side_stream_ = std::make_unique<Stream>();
     counters_.reserve(1);
     counters_host_.reserve(1);
     scan_counters_.reserve(1);
     scan_counts_host_.reserve(1);
-    SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), stream()));
+    SNAG_CUDA_CHECK(
+        cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side_stream_->get()));
     finish_ranks_.reserve(2 * kFinishLimit);
     finish_tickets_.reserve(2 * kFinishSlices);
     SNAG_CUDA_CHECK(
@@ -73,6 +75,8 @@ class CudaBackendImpl final : public CudaBackend {
   ~CudaBackendImpl() override {
     // A staged copy may still be reading a pinned buffer that is about to be freed.
     if (upload_stream_) cudaStreamSynchronize(upload_stream_->get());
+    // A scan cut short by an exception may still be writing pinned buffers.
+    if (side_stream_) cudaStreamSynchronize(side_stream_->get());
   }
 
   std::string_view name() const override { return "cuda"; }
@@ -245,12 +249,27 @@ class CudaBackendImpl final : public CudaBackend {
   /// in a checker's frame: the refit and the quality of every built tree that does not fit the
   /// current positions, queued before the scan's one wait (refit_part() and part_quality() then
   /// find them done). A build in between makes them moot, not wrong.
+  ///
+  /// The refits and the detect queued behind them (speculate_detect) go on the main stream:
+  /// the walks need the refit's boxes and planes, not the scan or the quality, which go on the
+  /// side stream, after the frame's positions and the refits respectively, so that the walks
+  /// do not wait for them. They are queued last, once the host has queued the main stream's
+  /// work, and the host's one wait here is for them alone.
   detect::DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) override {
     require_topology();
     detect::DegeneracyScan scan;
     if (topo_.triangle_count == 0) return scan;
-    const cudaStream_t s = stream();
-    timer_.start(s);
+    const cudaStream_t s = stream(), side = side_stream_->get();
+    timer_.start(s);  // also what the side stream waits for: the frame's positions
+    std::vector<int32_t> ahead;
+    for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
+      if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
+        ahead.push_back(p);
+    for (int32_t p : ahead) queue_refit(p, /*timed=*/false);  // its time is the scan's
+    refits_queued_.record(s);
+    speculate_detect();
+
+    SNAG_CUDA_CHECK(cudaStreamWaitEvent(side, timer_.start_event(), 0));
     // One launch per part; the last publishes the counts into host memory (none: no launch,
     // and the counts stay zero).
     size_t last_scanned = parts.size();
@@ -264,17 +283,10 @@ class CudaBackendImpl final : public CudaBackend {
                                part_size(parts[i]), mapped(scan_degenerate_host_.data()),
                                mapped(scan_uncertain_host_.data()), topo_.triangle_count,
                                scan_counters_.data(), i == last_scanned ? mapped(counts) : nullptr,
-                               s);
-    std::vector<int32_t> ahead;
-    for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
-      if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
-        ahead.push_back(p);
-    for (int32_t p : ahead) {
-      queue_refit(p, /*timed=*/false);  // its time is the scan's
-      trees_[p]->queue_quality(s);
-    }
-    timer_.stop_async(s);
-    speculate_detect();
+                               side);
+    if (!ahead.empty()) refits_queued_.wait_on(side);
+    for (int32_t p : ahead) trees_[p]->queue_quality(side);
+    timer_.stop_async(side);
     times_.scan = timer_.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
     for (int32_t p : ahead) {
@@ -286,8 +298,8 @@ class CudaBackendImpl final : public CudaBackend {
     for (int32_t p : parts) scanned += part_size(p);
     if (c.degenerate + c.uncertain > static_cast<unsigned long long>(scanned)) {
       // Counters left non-zero (a scan cut short): zeroed for the next scan, this one lost.
-      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), s));
-      stream_->synchronize();
+      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
+      side_stream_->synchronize();
       throw InternalError("cuda backend: the degenerate-triangle scan counted " +
                           std::to_string(c.degenerate + c.uncertain) + " of " +
                           std::to_string(scanned) + " triangles");
@@ -601,6 +613,10 @@ class CudaBackendImpl final : public CudaBackend {
   std::vector<uint64_t> slot_version_[2];  // per slot, per part: the version it holds (0: none)
   bool on_resident_ = false;               // current_positions_ is a resident frame
   std::unique_ptr<Stream> upload_stream_;
+  // The scan and the qualities queued ahead (scan_degenerate_parts), beside the main stream's
+  // refits and walks; the host waits for it before each scan returns.
+  std::unique_ptr<Stream> side_stream_;
+  Event refits_queued_;     // the main stream's refits queued ahead by a scan
   Event pinned_copied_[2];  // the last copy out of each pinned buffer
   Event slot_released_;     // main-stream work queued before a staged copy
   Event staged_ready_;      // the staged copy

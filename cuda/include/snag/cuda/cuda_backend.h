@@ -28,7 +28,8 @@ int cuda_device_count();
 struct StageTimes {
   double upload = 0;    ///< positions: pinned host buffer to device
   double scan = 0;      ///< degenerate-triangle scan with its result on the host; in a checker's
-                        ///< frame also the refit and the quality queued ahead of their calls
+                        ///< frame also the refit, the quality and the detect queued ahead of
+                        ///< their calls (the scan is queued after them, beside the detect)
   double build = 0;     ///< the whole GPU build, boxes and planes included
   double refit = 0;     ///< boxes and planes from the current positions (0 when refit() found
                         ///< the tree already fit to them, refit ahead in the scan or built)
