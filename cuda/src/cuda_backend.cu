@@ -166,6 +166,7 @@ class CudaBackendImpl final : public CudaBackend {
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
     const int slot = 1 - positions_slot_;
+    copy_staged_positions();
     if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_ &&
         same_moved(moved, staged_moved_)) {
       // Copied across while the previous frame was checked: the stream only waits for the copy.
@@ -197,9 +198,11 @@ class CudaBackendImpl final : public CudaBackend {
   }
 
   /// The next frame's positions go into the slot the current frame does not use, on their own
-  /// stream: the host copy into pinned memory now, while the device works on the current
-  /// frame, and the transfer alongside its kernels. That slot held the previous frame, whose
-  /// work is all queued before this point on the main stream: the copy waits for it. Parts
+  /// stream, alongside the current frame's kernels. That slot held the previous frame, whose
+  /// work is all queued before this point on the main stream: the transfer waits for it. The
+  /// host's copy into pinned memory (~40 us for 36K triangles) waits until the current frame's
+  /// work is queued (copy_staged_positions, from the scan's wait, else from detect's or the next
+  /// set): done here, a checker's frame began with it while the device had nothing to do. Parts
   /// whose version that slot holds already are not copied.
   void stage_part_positions(std::span<const geom::Vec3d> next,
                             std::span<const uint8_t> moved) override {
@@ -209,14 +212,11 @@ class CudaBackendImpl final : public CudaBackend {
     const std::vector<uint64_t> versions = next_versions(moved);
     if (slot_version_[positions_slot_] == versions) return;  // the next frame is this one
     const int slot = 1 - positions_slot_;
-    const cudaStream_t upload = upload_stream_->get();
     pinned_copied_[slot].synchronize();
     slot_released_.record(stream());
-    slot_released_.wait_on(upload);
-    copy_stale_parts(next, slot, versions, upload);
-    pinned_copied_[slot].record(upload);
-    staged_ready_.record(upload);
+    slot_released_.wait_on(upload_stream_->get());
     staged_ = true;
+    staged_copy_pending_ = true;
     staged_data_ = next.data();
     staged_size_ = next.size();
     staged_moved_.assign(moved.begin(), moved.end());
@@ -287,6 +287,7 @@ class CudaBackendImpl final : public CudaBackend {
     if (!ahead.empty()) refits_queued_.wait_on(side);
     for (int32_t p : ahead) trees_[p]->queue_quality(side);
     timer_.stop_async(side);
+    copy_staged_positions();  // the next frame's, while the device works on this one
     times_.scan = timer_.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
     for (int32_t p : ahead) {
@@ -454,11 +455,27 @@ class CudaBackendImpl final : public CudaBackend {
 
   cudaStream_t stream() const { return stream_->get(); }
 
+  /// Copies the staged frame into pinned memory and queues its transfer, when stage_part_positions
+  /// left that to do (the caller's span is valid until the next set_part_positions).
+  void copy_staged_positions() {
+    if (!staged_copy_pending_) return;
+    staged_copy_pending_ = false;
+    const int slot = 1 - positions_slot_;
+    const cudaStream_t upload = upload_stream_->get();
+    copy_stale_parts({staged_data_, staged_size_}, slot, staged_version_, upload);
+    pinned_copied_[slot].record(upload);
+    staged_ready_.record(upload);
+  }
+
   /// Forgets a staged frame that was not the next one set, once its copy (which writes the
-  /// slot a new frame will use) is done.
+  /// slot a new frame will use) is done; one not yet copied is simply forgotten.
   void drop_staged_positions() {
     if (!staged_) return;
     staged_ = false;
+    if (staged_copy_pending_) {
+      staged_copy_pending_ = false;
+      return;
+    }
     upload_stream_->synchronize();
   }
 
@@ -621,6 +638,7 @@ class CudaBackendImpl final : public CudaBackend {
   Event slot_released_;     // main-stream work queued before a staged copy
   Event staged_ready_;      // the staged copy
   bool staged_ = false;
+  bool staged_copy_pending_ = false;  // staged_, its host copy not made yet (copy_staged_positions)
   const geom::Vec3d* staged_data_ = nullptr;  // the staged frame, as the caller holds it
   size_t staged_size_ = 0;
   std::vector<uint8_t> staged_moved_;     // as the caller said
@@ -810,6 +828,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   if (!speculated) queue_detect(use, checks, owned);
   last_detect_ = {true, use, std::vector<int32_t>(checks.begin(), checks.end())};
 
+  copy_staged_positions();  // when no scan came first
   // The one wait. When a buffer overflowed, the counts say by how much: grow, run again. No
   // pair is lost, and a sequence allocates only while its counts grow.
   FrameCounters c{};
