@@ -70,6 +70,7 @@ std::vector<FrameRecord> small_frames() {
   f3.uncertain_tests = 1;
   f3.rebuilt = true;
   f3.tree_quality = 1.5;
+  f3.times.scan = 0.0625;
   f3.times.build = 0.5;
   f3.times.traverse = 0.25;
   f3.times.classify = 0.125;
@@ -99,7 +100,7 @@ constexpr const char* small_pairs_csv =
 constexpr const char* small_frames_csv =
     "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,seconds,rebuilt,"
     "topology_changed\n"
-    "3,cache/cloth.0003.obj,4,2,1,1,1,1,0.875000,1,0\n"
+    "3,cache/cloth.0003.obj,4,2,1,1,1,1,0.937500,1,0\n"
     "4,\"cache/cloth,\"\"b\"\".0004.obj\",4,0,0,0,0,0,0.500000,0,1\n";
 
 constexpr const char* small_report_json = R"json({
@@ -141,13 +142,14 @@ constexpr const char* small_report_json = R"json({
       },
       "seconds": {
         "read": 0.0625,
+        "scan": 0.0625,
         "build": 0.5,
         "refit": 0.0,
         "traverse": 0.25,
         "exact": 0.0,
         "classify": 0.125,
         "confirm": 0.0,
-        "total": 0.875
+        "total": 0.9375
       },
       "pairs": [
         {
@@ -193,6 +195,7 @@ constexpr const char* small_report_json = R"json({
       },
       "seconds": {
         "read": 0.125,
+        "scan": 0.0,
         "build": 0.0,
         "refit": 0.25,
         "traverse": 0.25,
@@ -235,7 +238,7 @@ constexpr const char* small_report_json = R"json({
     "builds": 1,
     "rebuilds": 0,
     "seconds": {
-      "check": 1.375,
+      "check": 1.4375,
       "read": 0.1875,
       "wall": 2.5
     },

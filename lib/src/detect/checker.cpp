@@ -146,7 +146,9 @@ FrameResult Checker::check(const FrameInput& input) {
       for (int32_t t = topo.layout.triangle_begin[p]; t < topo.layout.triangle_begin[p + 1]; ++t)
         scan.uncertain.push_back(t);
   } else if (!moved_parts.empty()) {
+    const auto start = Clock::now();
     scan = backend_->scan_degenerate_parts(moved_parts);
+    result.times.scan = seconds_since(start);
   }
   result.degenerate = std::move(scan.degenerate);
   for (int32_t t : last_degenerate_)

@@ -32,7 +32,11 @@ struct StageTimes {
   double exact = 0;     ///< uncertain tests decided with exact predicates
   double classify = 0;  ///< sorting, deduplication and crossing/touching
   double confirm = 0;   ///< independent confirmation of the reported pairs (`--exact all`)
-  double total() const { return build + refit + traverse + exact + classify + confirm; }
+  /// The degenerate-triangle scan. A backend may queue the refit, the tree quality and the
+  /// traversal ahead of their calls and start them with it (the GPU's does): its wait then
+  /// covers their start, and their own stages only what was left.
+  double scan = 0;
+  double total() const { return scan + build + refit + traverse + exact + classify + confirm; }
 };
 
 /// One part (a scene's object) in one frame.
