@@ -341,7 +341,8 @@ Row run_scene(const SceneCase& c, const std::string& backend, const BenchSceneOp
       next = frames[i + 1].mesh.positions;
       next_moved = moved_between(f, frames[i + 1]);
     }
-    detect::FrameResult r = checker->check({f.mesh.positions, moved, next, next_moved});
+    detect::FrameResult r =
+        checker->check({f.mesh.positions, moved, next, next_moved, /*finite=*/true});
     check_ms.push_back(ms_since(started));
     outcomes.push_back(
         {static_cast<int64_t>(r.pairs.size()), std::move(r.parts), std::move(r.checks)});

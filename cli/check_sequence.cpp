@@ -339,8 +339,9 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       next_moved = moved_between(scene_frame, following.frame->item);
     }
     lap(times.preparing);
+    // Read by snag's readers, which reject non-finite coordinates.
     const detect::FrameResult result =
-        checker.check({mesh.positions, moved, next_positions, next_moved});
+        checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});
     lap(times.checking);
 
     report::FrameRecord record;

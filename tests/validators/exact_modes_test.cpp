@@ -172,6 +172,32 @@ TEST(CgalConfirmer, ADisagreementIsAnInternalErrorNamingThePair) {
                InternalError);
 }
 
+TEST(ExactModes, FramesVouchedFiniteGiveTheSameAnswers) {
+  // FrameInput::finite skips the guard below and nothing else: the same pairs, kinds and
+  // degenerate faces on a soup with every kind of contact, over two frames (the second a refit).
+  Soup soup = rounded_lattice_soup(300, 7, 0.1, 0.3);
+  std::vector<geom::Vec3d> moved = soup.positions;
+  for (geom::Vec3d& p : moved) p.z += 0.01 * p.x;
+  for (ExactMode mode : {ExactMode::off, ExactMode::uncertain, ExactMode::all}) {
+    detect::CheckSettings settings;
+    settings.exact = mode;
+    auto guarded = make_checker(detect::make_cpu_backend(2), settings);
+    auto vouched = make_checker(detect::make_cpu_backend(2), settings);
+    guarded->set_triangles(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    vouched->set_triangles(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    for (const auto* frame : {&soup.positions, &moved}) {
+      const detect::FrameResult a = guarded->check(*frame);
+      detect::FrameInput input;
+      input.positions = *frame;
+      input.finite = true;
+      const detect::FrameResult b = vouched->check(input);
+      ASSERT_FALSE(a.pairs.empty());
+      EXPECT_EQ(a.pairs, b.pairs) << detect::to_string(mode);
+      EXPECT_EQ(a.degenerate, b.degenerate) << detect::to_string(mode);
+    }
+  }
+}
+
 TEST(ExactModes, NanAndInfinityAreInputErrorsInEveryMode) {
   // Readers reject such files; the checker itself must not answer (NaN compares false, so
   // pairs vanish) nor crash (CGAL traps converting infinity to an exact number).

@@ -105,10 +105,11 @@ FrameResult Checker::check(const FrameInput& input) {
     for (int32_t p = 0; p < part_count; ++p) moved[p] = input.moved[p] != 0;
   }
   // Every decision assumes finite coordinates (NaN compares false everywhere, and CGAL cannot
-  // convert infinity to an exact number). Readers reject such files; this guards the API. A
-  // coordinate minus itself is 0 unless it is NaN or infinite, so one sum tells.
+  // convert infinity to an exact number). Readers reject such files; this guards the API
+  // (FrameInput::finite). A coordinate minus itself is 0 unless it is NaN or infinite, so one
+  // sum tells.
   for (int32_t p = 0; p < part_count; ++p) {
-    if (!moved[p]) continue;
+    if (!moved[p] || input.finite) continue;
     double poison = 0;
     for (int32_t v = topo.layout.vertex_begin[p]; v < topo.layout.vertex_begin[p + 1]; ++v)
       poison += (positions[v].x - positions[v].x) + (positions[v].y - positions[v].y) +

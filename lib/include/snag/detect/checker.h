@@ -42,6 +42,11 @@ struct FrameInput {
   /// `positions`.
   std::span<const geom::Vec3d> next_positions;
   std::span<const uint8_t> next_moved;
+  /// The caller vouches that every coordinate of `positions` is finite, as snag's readers
+  /// guarantee (they reject NaN and infinity with the file and line): check() then skips its
+  /// own pass over them. That pass guards the API; in a pipeline, over a frame another thread
+  /// has just read, it took ~40 us of an 18K-vertex GPU frame's ~250 on the H100's host.
+  bool finite = false;
 };
 
 class Checker {
