@@ -227,7 +227,7 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
   const std::string object_margin = indent(level + 1), member_margin = indent(level + 2);
   const bool scene = !names.empty();
   // The text between a pair's values, each one piece: a pair is then 5 (single mesh) or 9
-  // (scene) appends and 4 numbers, not a dozen small appends.
+  // (scene) copies and 4 numbers, not a dozen small appends.
   const std::string member_break = ",\n" + member_margin;
   const std::string open_first = "\n" + object_margin + "{\n" + member_margin + "\"a\": ";
   const std::string open_next = "," + open_first;
@@ -240,32 +240,49 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
   const std::string before_object_a = member_break + "\"object_a\": ";
   const std::string before_object_b = member_break + "\"object_b\": ";
   const std::string close = "\n" + object_margin + "}";
-  out.reserve(out.size() +
-              pairs.size() * ((scene ? 8 : 6) * member_margin.size() + (scene ? 160 : 96)));
-  out += '[';
-  char number[16];
-  const auto add_number = [&](int32_t value) {
-    const auto [end, ec] = std::to_chars(number, number + sizeof number, value);
-    out.append(number, end);
-  };
+  // Written through a cursor into space sized for the longest pair, then trimmed: appending
+  // piece by piece spent as long on the string's bookkeeping as on the numbers.
+  size_t longest_name = 0;
+  for (const std::string& name : names) longest_name = std::max(longest_name, name.size());
+  const size_t longest_pair =
+      open_next.size() + before_b.size() + crossing_then_poly.size() + before_poly_b.size() +
+      close.size() + 4 * 11 +
+      (scene ? before_object_a.size() + before_object_b.size() + 2 * (longest_name + 2) : 0);
+  const size_t start = out.size();
+  out.resize(start + 1 + pairs.size() * longest_pair);
+  char* at = out.data() + start;
+  *at++ = '[';
+  const auto put = [&](std::string_view text) { at = std::copy(text.begin(), text.end(), at); };
+  const auto put_number = [&](int32_t value) { at = std::to_chars(at, at + 11, value).ptr; };
+  // A scene pair naming no object throws (pair_object_name): `out` is left as it came.
+  struct Restore {
+    std::string& out;
+    size_t size;
+    bool done = false;
+    ~Restore() {
+      if (!done) out.resize(size);
+    }
+  } restore{out, start};
   for (size_t i = 0; i < pairs.size(); ++i) {
     const Pair& p = pairs[i];
-    out += i == 0 ? open_first : open_next;
-    add_number(p.a);
-    out += before_b;
-    add_number(p.b);
-    out += p.kind == detect::PairKind::crossing ? crossing_then_poly : touching_then_poly;
-    add_number(p.poly_a);
-    out += before_poly_b;
-    add_number(p.poly_b);
+    put(i == 0 ? open_first : open_next);
+    put_number(p.a);
+    put(before_b);
+    put_number(p.b);
+    put(p.kind == detect::PairKind::crossing ? crossing_then_poly : touching_then_poly);
+    put_number(p.poly_a);
+    put(before_poly_b);
+    put_number(p.poly_b);
     if (scene) {
-      out += before_object_a;
-      out += pair_object_name(names, f, p, p.object_a);
-      out += before_object_b;
-      out += pair_object_name(names, f, p, p.object_b);
+      put(before_object_a);
+      put(pair_object_name(names, f, p, p.object_a));
+      put(before_object_b);
+      put(pair_object_name(names, f, p, p.object_b));
     }
-    out += close;
+    put(close);
   }
+  out.resize(static_cast<size_t>(at - out.data()));
+  restore.done = true;
   if (!pairs.empty()) {
     out += '\n';
     out += indent(level);
