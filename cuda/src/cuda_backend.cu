@@ -75,8 +75,10 @@ class CudaBackendImpl final : public CudaBackend {
   ~CudaBackendImpl() override {
     // A staged copy may still be reading a pinned buffer that is about to be freed.
     if (upload_stream_) cudaStreamSynchronize(upload_stream_->get());
-    // A scan cut short by an exception may still be writing pinned buffers.
+    // A frame cut short by an exception may still be writing pinned buffers: its scan, or the
+    // detect queued ahead of it.
     if (side_stream_) cudaStreamSynchronize(side_stream_->get());
+    if (stream_) cudaStreamSynchronize(stream_->get());
   }
 
   std::string_view name() const override { return "cuda"; }
@@ -142,7 +144,7 @@ class CudaBackendImpl final : public CudaBackend {
     for (int32_t p = 0; p < parts; ++p) {
       if (!trees_[p]) trees_[p] = std::make_unique<DeviceTree>();
       trees_[p]->level_by_level_refit = level_by_level_refit_;
-      trees_[p]->resize(part_size(p));
+      trees_[p]->resize(part_size(p), stream());
     }
     part_.assign(static_cast<size_t>(parts), PartState{});
     for (int slot = 0; slot < 2; ++slot) slot_version_[slot].assign(static_cast<size_t>(parts), 0);
@@ -166,10 +168,11 @@ class CudaBackendImpl final : public CudaBackend {
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
     const int slot = 1 - positions_slot_;
-    copy_staged_positions();
     if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_ &&
         same_moved(moved, staged_moved_)) {
-      // Copied across while the previous frame was checked: the stream only waits for the copy.
+      // Copied across while the previous frame was checked: the stream only waits for the copy
+      // (made now if it is still to make: `positions` is that span, valid in this call).
+      copy_staged_positions();
       staged_ = false;
       staged_ready_.wait_on(stream());
       upload_pending_ = false;
@@ -277,6 +280,11 @@ class CudaBackendImpl final : public CudaBackend {
       if (part_size(parts[i]) > 0) last_scanned = i;
     ScanCounts* const counts = scan_counts_host_.data();
     *counts = {};
+    // A scan cut short (an exception between its launches and its counts read) may have left
+    // counts in the counters, which only a whole scan zeroes: cleared first.
+    if (scan_pending_)
+      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
+    scan_pending_ = true;
     for (size_t i = 0; i < parts.size(); ++i)
       if (part_size(parts[i]) > 0)
         launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(parts[i]),
@@ -295,10 +303,12 @@ class CudaBackendImpl final : public CudaBackend {
       part_[p].quality_ready = true;
     }
     const ScanCounts c = *counts;
+    scan_pending_ = false;
     int64_t scanned = 0;
     for (int32_t p : parts) scanned += part_size(p);
     if (c.degenerate + c.uncertain > static_cast<unsigned long long>(scanned)) {
-      // Counters left non-zero (a scan cut short): zeroed for the next scan, this one lost.
+      // Counters not zero at the start (scan_pending_ should have seen to it): zeroed for the
+      // next scan, this one lost.
       SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
       side_stream_->synchronize();
       throw InternalError("cuda backend: the degenerate-triangle scan counted " +
@@ -456,7 +466,10 @@ class CudaBackendImpl final : public CudaBackend {
   cudaStream_t stream() const { return stream_->get(); }
 
   /// Copies the staged frame into pinned memory and queues its transfer, when stage_part_positions
-  /// left that to do (the caller's span is valid until the next set_part_positions).
+  /// left that to do: from this frame's scan or detect, while the staged span is valid (until
+  /// the next set_part_positions), or from that set when it is given the same span. A staged
+  /// frame that is not the next one set is forgotten without being read (drop_staged_positions):
+  /// its span may be gone by then.
   void copy_staged_positions() {
     if (!staged_copy_pending_) return;
     staged_copy_pending_ = false;
@@ -651,6 +664,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<FrameCounters> counters_;
   PinnedBuffer<FrameCounters> counters_host_;  // the detect's, written by finish_kernel
   DeviceBuffer<ScanCounters> scan_counters_;   // zero between scans (the scan leaves them so)
+  bool scan_pending_ = false;  // a scan's launches queued, its counts not read yet
   PinnedBuffer<ScanCounts> scan_counts_host_;  // the last scan's counts, written by its kernel
   DetectCall last_detect_;
   Speculation speculation_;

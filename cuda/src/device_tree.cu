@@ -281,14 +281,16 @@ __global__ void __launch_bounds__(kQualityThreads)
 
 }  // namespace
 
-void DeviceTree::resize(int32_t n) {
+void DeviceTree::resize(int32_t n, cudaStream_t stream) {
   shape_ = n > 0 ? CompleteTree(n) : CompleteTree();
   if (n <= capacity_) return;
   const size_t count = static_cast<size_t>(n);
   boxes_.reserve(2 * count - 1);
   triangle_at_.reserve(count);
   refit_ticket_.reserve(1);
-  SNAG_CUDA_CHECK(cudaMemset(refit_ticket_.data(), 0, sizeof(unsigned)));
+  // On the caller's stream: a plain cudaMemset goes on the legacy stream, which does not
+  // order with the backend's non-blocking streams.
+  SNAG_CUDA_CHECK(cudaMemsetAsync(refit_ticket_.data(), 0, sizeof(unsigned), stream));
   centroids_.reserve(count);
   lists_.reserve(3 * count);
   lists_alt_.reserve(3 * count);
@@ -300,7 +302,7 @@ void DeviceTree::resize(int32_t n) {
   quality_host_.reserve(1);
   quality_out_ = mapped(quality_host_.data());
   quality_ticket_.reserve(1);
-  SNAG_CUDA_CHECK(cudaMemset(quality_ticket_.data(), 0, sizeof(unsigned)));
+  SNAG_CUDA_CHECK(cudaMemsetAsync(quality_ticket_.data(), 0, sizeof(unsigned), stream));
   quality_blocks_.reserve(static_cast<size_t>((n + bvh::kQualityBlock - 1) / bvh::kQualityBlock));
   // Scratch for the sorts and the scans, sized for the largest of them.
   size_t sort_bytes = 0, scan_bytes = 0;
@@ -314,7 +316,7 @@ void DeviceTree::resize(int32_t n) {
 
 void DeviceTree::build(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cudaStream_t stream) {
   const int32_t n = mesh.triangle_count;
-  resize(n);
+  resize(n, stream);
   if (n == 0) return;
   const size_t count = static_cast<size_t>(n);
   launch(centroid_keys_kernel, n, stream, mesh, centroids_.data(), keys_.data(), ids_.data());

@@ -22,8 +22,9 @@ namespace snag::cuda {
 
 class DeviceTree {
  public:
-  /// Makes room for a tree over n triangles (allocates only when n grows).
-  void resize(int32_t n);
+  /// Makes room for a tree over n triangles (allocates only when n grows); scratch that must
+  /// start zero is cleared on `stream`.
+  void resize(int32_t n, cudaStream_t stream);
 
   /// Builds the tree over `mesh` (device pointers) on `stream`, then refits it. Asynchronous.
   ///

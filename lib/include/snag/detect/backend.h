@@ -59,7 +59,9 @@ class Backend {
                                   std::span<const uint8_t> moved) = 0;
   /// The next frame's positions, given while the current one is checked, so that a backend
   /// with memory of its own can copy them across meanwhile; a set_part_positions() with the
-  /// same span (same address and size, contents unchanged since) then copies nothing. A hint:
+  /// same span (same address and size, contents unchanged since) then copies nothing. The span
+  /// must stay valid and unchanged until the next set_part_positions() (the GPU backend reads
+  /// it while the current frame's work runs); a different span then drops it unread. A hint:
   /// the CPU backend has nothing to copy, and a span never set is dropped. `moved` as in
   /// set_part_positions, relative to the frame being checked.
   virtual void stage_part_positions(std::span<const geom::Vec3d> next,
