@@ -280,8 +280,9 @@ class CudaBackendImpl final : public CudaBackend {
       if (part_size(parts[i]) > 0) last_scanned = i;
     ScanCounts* const counts = scan_counts_host_.data();
     *counts = {};
-    // A scan cut short (an exception between its launches and its counts read) may have left
-    // counts in the counters, which only a whole scan zeroes: cleared first.
+    // A scan cut short (an exception between its launches and its counts read) or whose counts
+    // were wrong may have left counts in the counters, which only a whole scan zeroes: cleared
+    // first.
     if (scan_pending_)
       SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
     scan_pending_ = true;
@@ -303,18 +304,16 @@ class CudaBackendImpl final : public CudaBackend {
       part_[p].quality_ready = true;
     }
     const ScanCounts c = *counts;
-    scan_pending_ = false;
     int64_t scanned = 0;
     for (int32_t p : parts) scanned += part_size(p);
     if (c.degenerate + c.uncertain > static_cast<unsigned long long>(scanned)) {
-      // Counters not zero at the start (scan_pending_ should have seen to it): zeroed for the
-      // next scan, this one lost.
-      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
-      side_stream_->synchronize();
+      // Counters not zero at the start: this scan is lost, and scan_pending_, left set, has
+      // the next one clear them first.
       throw InternalError("cuda backend: the degenerate-triangle scan counted " +
                           std::to_string(c.degenerate + c.uncertain) + " of " +
                           std::to_string(scanned) + " triangles");
     }
+    scan_pending_ = false;
     scan.degenerate.assign(scan_degenerate_host_.data(),
                            scan_degenerate_host_.data() + c.degenerate);
     scan.uncertain.assign(scan_uncertain_host_.data(), scan_uncertain_host_.data() + c.uncertain);
@@ -566,10 +565,11 @@ class CudaBackendImpl final : public CudaBackend {
   }
 
   /// frame.pairs and frame.kind_certain from `count` (a << pair_bits_ | b) keys and their
-  /// statuses (bit 0: touching, bit 1: certain), key_and_status(i) giving the i-th.
+  /// statuses (bit 0: touching, bit 1: certain), key_and_status(i) giving the i-th. Returns
+  /// how many kinds are not certain.
   template <class KeyAndStatus>
-  void decode_pairs(size_t count, detect::FilteredFrame& frame,
-                    KeyAndStatus&& key_and_status) const {
+  int64_t decode_pairs(size_t count, detect::FilteredFrame& frame,
+                       KeyAndStatus&& key_and_status) const {
     frame.pairs.resize(count);
     frame.kind_certain.resize(count);
     // Through local pointers: with frame.pairs[i] the compiler reloads the vector's storage
@@ -578,12 +578,15 @@ class CudaBackendImpl final : public CudaBackend {
     uint8_t* const certain = frame.kind_certain.data();
     const int bits = pair_bits_;
     const uint64_t mask = (uint64_t{1} << bits) - 1;
+    int64_t uncertain_kinds = 0;
     for (size_t i = 0; i < count; ++i) {
       const auto [key, status] = key_and_status(i);
       pairs[i] = {static_cast<int32_t>(key >> bits), static_cast<int32_t>(key & mask),
                   static_cast<detect::PairKind>(status & 1)};
       certain[i] = static_cast<uint8_t>(status >> 1);
+      uncertain_kinds += 1 - (status >> 1);
     }
+    return uncertain_kinds;
   }
   /// frame.uncertain from `count` (edge << 32 | triangle) keys.
   static void decode_tasks(const uint64_t* keys, size_t count, detect::FilteredFrame& frame) {
@@ -664,7 +667,7 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<FrameCounters> counters_;
   PinnedBuffer<FrameCounters> counters_host_;  // the detect's, written by finish_kernel
   DeviceBuffer<ScanCounters> scan_counters_;   // zero between scans (the scan leaves them so)
-  bool scan_pending_ = false;  // a scan's launches queued, its counts not read yet
+  bool scan_pending_ = false;  // a scan's launches queued, its counts not yet read and accepted
   PinnedBuffer<ScanCounts> scan_counts_host_;  // the last scan's counts, written by its kernel
   DetectCall last_detect_;
   Speculation speculation_;
@@ -928,19 +931,19 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   // the device-wide sorts' keys and statuses.
   const auto pair_count = static_cast<size_t>(c.pairs);
   const auto task_count = static_cast<size_t>(c.uncertain);
-  if (large_pairs)
-    decode_pairs(pair_count, frame, [&](size_t i) {
-      return std::pair<uint64_t, uint8_t>{keys_host_.data()[i], status_host_.data()[i]};
-    });
-  else
-    decode_pairs(pair_count, frame, [&](size_t i) {
-      const uint64_t packed = host_pairs_.data()[i];
-      return std::pair<uint64_t, uint8_t>{packed & ((uint64_t{1} << kStatusShift) - 1),
-                                          static_cast<uint8_t>(packed >> kStatusShift)};
-    });
+  const int64_t uncertain_kinds =
+      large_pairs
+          ? decode_pairs(pair_count, frame,
+                         [&](size_t i) {
+                           return std::pair<uint64_t, uint8_t>{keys_host_.data()[i],
+                                                               status_host_.data()[i]};
+                         })
+          : decode_pairs(pair_count, frame, [&](size_t i) {
+              const uint64_t packed = host_pairs_.data()[i];
+              return std::pair<uint64_t, uint8_t>{packed & ((uint64_t{1} << kStatusShift) - 1),
+                                                  static_cast<uint8_t>(packed >> kStatusShift)};
+            });
   decode_tasks(large_tasks ? uncertain_host_.data() : host_uncertain_.data(), task_count, frame);
-  const auto uncertain_kinds = static_cast<int64_t>(
-      std::count(frame.kind_certain.begin(), frame.kind_certain.end(), uint8_t{0}));
   frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) +
                          static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
   frame.classify_seconds = seconds_since(classify_start);
