@@ -117,6 +117,10 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.edge_face_offsets, topology.edge_face_offsets.data(),
            topology.edge_face_offsets.size(), s);
     upload(d.edge_faces, topology.edge_faces.data(), topology.edge_faces.size(), s);
+    d.has_fans = !topology.fan_steps.empty();
+    upload(d.fan_begin, topology.fan_begin.data(), d.has_fans ? topology.fan_begin.size() : 0, s);
+    upload(d.fan_steps, topology.fan_steps.data(), topology.fan_steps.size(), s);
+    d.fan_clear.reserve(std::max<size_t>(d.has_fans ? d.vertex_count : 0, 1));
     d.frame_owned_edges.reserve(std::max<size_t>(n, 1));
     d.degenerate.reserve(std::max<size_t>(n, 1));
     d.degenerate_list.reserve(std::max<size_t>(n, 1));
@@ -743,8 +747,19 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
                     planes_.data() + part_begin(p), s);
       part.planes_version = part.version;
     }
+  // The fans of the parts checked against themselves, which their pair tests read.
+  const bool fans = use == detect::FilterUse::certify && topo_.has_fans;
+  if (fans)
+    for (int32_t c : checks) {
+      const detect::PartCheck check = topology_->checks[c];
+      if (!check.self() || part_size(check.a) == 0) continue;
+      const int32_t first = topology_->layout.vertex_begin[check.a];
+      launch_fans(current_positions_, planes_.data(),
+                  {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
+                  topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data(), s);
+    }
   PairInputs inputs;
-  inputs.frame = {current_positions_, planes_.data()};
+  inputs.frame = {current_positions_, planes_.data(), fans ? topo_.fan_clear.data() : nullptr};
   inputs.topology.triangles = topo_.triangles.data();
   inputs.topology.edges = topo_.edges.data();
   inputs.topology.triangle_edges = topo_.triangle_edges.data();

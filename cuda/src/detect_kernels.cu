@@ -128,6 +128,13 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
+__global__ void fans_kernel(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
+                            detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear) {
+  wait_for_previous_kernel();
+  const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (i < n) fan_clear[first + i] = detect::fan_is_clear(positions, planes, fans, first + i);
+}
+
 /// A walk's listing (of candidate pairs, or of subwalks): its thread's keys held in a small
 /// local array and appended to the list a chunk at a time. Appending each key on its own
 /// serialised the walks on the list's counter. A full chunk, met inside the walk's divergent
@@ -481,6 +488,12 @@ void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degener
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
                    geom::PlaneCoefficients* planes, cudaStream_t stream) {
   launch_chained_items(planes_kernel, n, stream, positions, triangles, n, planes);
+}
+
+void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
+                 detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
+                 cudaStream_t stream) {
+  launch_chained_items(fans_kernel, n, stream, positions, planes, fans, first, n, fan_clear);
 }
 
 namespace {

@@ -164,6 +164,12 @@ void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* trian
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
                             cudaStream_t stream);
 
+/// fan_clear[v] = detect::fan_is_clear(positions, planes, fans, v) for the vertices [first,
+/// first + n), after the planes of their triangles.
+void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
+                 detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
+                 cudaStream_t stream);
+
 /// planes[t] = the plane of triangle t (detect::triangle_plane). The refit computes them too; this
 /// is for frames whose tree was not refit to the current positions.
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,

@@ -7,6 +7,7 @@
 
 #include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
+#include "snag/detect/fan.h"
 #include "snag/detect/pair_test.h"
 #include "snag/detect/pairs.h"
 #include "snag/geom/narrow_phase.h"
@@ -257,7 +258,22 @@ class CpuBackend final : public Backend {
           planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
       }
     }
-    const FrameView frame_view{positions_.data(), planes_.data()};
+    // The fans of the parts checked against themselves: their pairs' tests read them.
+    if constexpr (use == FilterUse::certify) {
+      fan_clear_.resize(static_cast<size_t>(topo.vertex_count));
+      const FanView fans{topo.fan_begin.data(), topo.fan_steps.data()};
+      for (int32_t c : checks) {
+        if (!topo.checks[c].self()) continue;
+        const int32_t part = topo.checks[c].a;
+        const int32_t begin = topo.layout.vertex_begin[part];
+        const int32_t end = topo.layout.vertex_begin[part + 1];
+#pragma omp parallel for num_threads(threads_) schedule(static)
+        for (int32_t v = begin; v < end; ++v)
+          fan_clear_[v] = fan_is_clear(positions_.data(), planes_.data(), fans, v) ? 1 : 0;
+      }
+    }
+    const FrameView frame_view{positions_.data(), planes_.data(),
+                               use == FilterUse::certify ? fan_clear_.data() : nullptr};
 
     std::vector<ThreadSink> sinks(static_cast<size_t>(threads_));
     for (int32_t c : checks) {
@@ -399,6 +415,7 @@ class CpuBackend final : public Backend {
   const Topology* topology_ = nullptr;
   std::span<const geom::Vec3d> positions_;
   std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
+  std::vector<uint8_t> fan_clear_;               ///< per vertex, this frame: fan_is_clear
   std::vector<bvh::Tree> trees_;                 ///< per part
 };
 

@@ -15,6 +15,63 @@ struct EdgeRecord {
   int32_t corner;  // the triangle's edge k joins corners k and k + 1
 };
 
+/// The fan of vertex v (Topology::fan_steps) from its usable triangles `around` (increasing
+/// ids, at most kMaxListedValence), appended to topo.fan_steps; nothing when they do not form
+/// one strip around v or form one too short to hold a pair.
+void append_fan(Topology& topo, int32_t v, std::span<const int32_t> around) {
+  const auto k = static_cast<int32_t>(around.size());
+  if (k < 2) return;
+  // Each triangle's corners after v in its own order: (v, next, prev).
+  std::array<int32_t, Topology::kMaxListedValence> next, prev;
+  for (int32_t i = 0; i < k; ++i) {
+    const geom::Tri t = topo.triangles[around[i]];
+    const int c = t.v[0] == v ? 0 : (t.v[1] == v ? 1 : 2);
+    next[i] = t.v[(c + 1) % 3];
+    prev[i] = t.v[(c + 2) % 3];
+  }
+  // How many of the triangles each neighbouring vertex is in: a strip has every one in two,
+  // or (open) exactly two ends in one.
+  auto uses = [&](int32_t a) {
+    int32_t count = 0;
+    for (int32_t i = 0; i < k; ++i) count += (next[i] == a) + (prev[i] == a);
+    return count;
+  };
+  int32_t first = 0, start = next[0], ends = 0;
+  for (int32_t i = 0; i < k; ++i)
+    for (const int32_t a : {next[i], prev[i]}) {
+      const int32_t count = uses(a);
+      if (count > 2) return;
+      if (count == 1 && ends++ == 0) {  // the first end found lies in the smallest such triangle
+        first = i;
+        start = a;
+      }
+    }
+  if (ends != 0 && ends != 2) return;
+  const bool closed = ends == 0;
+  if (closed && k < 3) return;  // two triangles on the same three vertices: a duplicated face
+  const auto begin = topo.fan_steps.size();
+  std::array<bool, Topology::kMaxListedValence> used{};
+  int32_t at = first, corner = start;
+  for (int32_t step = 0; step < k; ++step) {
+    used[at] = true;
+    const bool reversed = next[at] != corner;  // t runs (v, a_{i+1}, a_i)
+    topo.fan_steps.push_back({corner, 2 * around[at] + (reversed ? 1 : 0)});
+    corner = reversed ? next[at] : prev[at];  // a_{i+1}
+    if (step + 1 == k) break;
+    at = -1;
+    for (int32_t i = 0; i < k && at < 0; ++i)
+      if (!used[i] && (next[i] == corner || prev[i] == corner)) at = i;
+    if (at < 0) break;  // the strip ended before taking every triangle: more than one strip
+  }
+  const bool whole =
+      topo.fan_steps.size() - begin == static_cast<size_t>(k) && (closed ? corner == start : true);
+  if (!whole) {
+    topo.fan_steps.resize(begin);
+    return;
+  }
+  if (!closed) topo.fan_steps.push_back({corner, -1});
+}
+
 /// Lists the pairs of triangles around each vertex of valence at most kMaxListedValence, in
 /// (a, b) order without sorting the list: each triangle t gathers the later triangles of its
 /// listed corners' fans (a few dozen at most), sorts and dedupes those, and the triangles
@@ -42,6 +99,19 @@ void make_neighbor_pairs(Topology& topo) {
     else
       topo.listed_vertex[v] = 1;
   }
+  // The fans of the listed vertices of parts checked against themselves.
+  std::vector<uint8_t> self_part(static_cast<size_t>(topo.part_count()), 0);
+  for (const PartCheck& c : topo.checks)
+    if (c.self()) self_part[c.a] = 1;
+  topo.fan_begin.assign(static_cast<size_t>(topo.vertex_count) + 1, 0);
+  topo.fan_steps.clear();
+  for (int32_t p = 0; p < topo.part_count(); ++p)
+    for (int32_t v = topo.layout.vertex_begin[p]; v < topo.layout.vertex_begin[p + 1]; ++v) {
+      if (self_part[p] && topo.listed_vertex[v])
+        append_fan(topo, v,
+                   std::span<const int32_t>(fan.data() + offsets[v], fan.data() + offsets[v + 1]));
+      topo.fan_begin[v + 1] = static_cast<int32_t>(topo.fan_steps.size());
+    }
   std::vector<std::array<int32_t, 2>>& pairs = topo.neighbor_pairs;
   pairs.clear();
   topo.neighbor_shared.clear();

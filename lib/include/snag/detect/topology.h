@@ -31,6 +31,16 @@ struct PartCheck {
   friend auto operator<=>(const PartCheck&, const PartCheck&) = default;
 };
 
+/// One step around a vertex v's fan (Topology::fan_steps): the fan's triangles t_0, t_1, ... in
+/// order around v, t_i = (v, a_i, a_{i+1}) sharing the edge (v, a_{i+1}) with t_{i+1}.
+struct FanStep {
+  int32_t corner;  ///< a_i
+  /// 2 t_i, plus 1 when t_i's corners run (v, a_{i+1}, a_i) rather than (v, a_i, a_{i+1}) in
+  /// its own cyclic order (its plane's normal then points against the fan's); -1 on the last
+  /// step of an open fan, which only closes the last triangle with its corner a_k.
+  int32_t face;
+};
+
 /// Edge k of a triangle joins corners k and (k + 1) % 3.
 struct Topology {
   std::vector<geom::Tri> triangles;
@@ -61,6 +71,15 @@ struct Topology {
   std::vector<uint8_t> listed_vertex;  ///< per vertex: 1 when its fan's pairs are listed
   bool every_vertex_listed = true;
   static constexpr int32_t kMaxListedValence = 32;
+  /// Fans (see detect/fan.h): for a listed vertex v of a part checked against itself whose
+  /// triangles (those not repeating a corner) form one strip around it, each sharing an
+  /// edge with the next and every such edge shared by two of them, fan_steps[fan_begin[v] ..
+  /// fan_begin[v + 1]) walks around it: k steps for a closed fan of k >= 3 triangles (an
+  /// interior vertex), k + 1 for an open one of k >= 2 (a border vertex). Other vertices have
+  /// no steps. The walk starts at the smallest triangle (an open fan: at its end whose
+  /// first triangle has the smaller id) and goes on across t_0's edge after v in t_0's order.
+  std::vector<int32_t> fan_begin;  ///< vertex_count + 1 offsets
+  std::vector<FanStep> fan_steps;
 
   /// The parts (one for a single mesh) and the checks between them, in increasing (a, b).
   /// Neighbour pairs never join two parts (they share no vertex); those of part p's self

@@ -101,8 +101,15 @@ struct PlaneCoefficients {
   double permanent[3];
 
   SNAG_HD_INLINE static PlaneCoefficients of(Vec3d a, Vec3d b, Vec3d c) {
-    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
-    const double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+    return of_rows(b - a, c - a);
+  }
+
+  /// The coefficients of det[u, v, .] for rows given as vectors, each component exact or one
+  /// rounded difference of inputs (of(a, b, c) is of_rows(b - a, c - a)); the bound holds as for
+  /// of(), rows with fewer roundings only tightening it.
+  SNAG_HD_INLINE static PlaneCoefficients of_rows(Vec3d u, Vec3d v) {
+    const double ux = u.x, uy = u.y, uz = u.z;
+    const double vx = v.x, vy = v.y, vz = v.z;
     const double uyvz = uy * vz, uzvy = uz * vy, uzvx = uz * vx, uxvz = ux * vz, uxvy = ux * vy,
                  uyvx = uy * vx;
     PlaneCoefficients k{
@@ -131,19 +138,25 @@ SNAG_HD inline Sign plane_side_rare(Vec3d a, Vec3d b, Vec3d c, Vec3d d, double p
 }
 }  // namespace detail
 
+/// The filter's sign of det[u, v, w] for k = PlaneCoefficients::of_rows(u, v) and a third row
+/// `w` whose components are exact or one rounded difference each, else Sign::uncertain; `perm`
+/// receives the permanent.
+SNAG_HD_INLINE Sign row_side_filter(const PlaneCoefficients& k, Vec3d w, double& perm) {
+  const double det = w.x * k.minor[0] + w.y * k.minor[1] + w.z * k.minor[2];
+  perm = fabs(w.x) * k.permanent[0] + fabs(w.y) * k.permanent[1] + fabs(w.z) * k.permanent[2];
+  if (perm >= detail::kMinPermanent &&
+      fabs(det) > detail::kOrient3dBound * perm + detail::kUnderflowSlack)
+    return detail::sign_of(det);
+  return Sign::uncertain;
+}
+
 /// The filter part of plane_side: the sign of det[b - a, c - a, d - a] when the bound certifies
 /// it, else Sign::uncertain; `perm` receives the permanent for plane_side_rare. The plane's
 /// products cannot underflow (PlaneCoefficients::of makes such a plane's queries uncertain);
 /// the query's three products w_k * minor_k can, by at most 2^-1075 each, which the absolute
 /// term kUnderflowSlack covers.
 SNAG_HD_INLINE Sign plane_side_filter(const PlaneCoefficients& k, Vec3d a, Vec3d d, double& perm) {
-  const double wx = d.x - a.x, wy = d.y - a.y, wz = d.z - a.z;
-  const double det = wx * k.minor[0] + wy * k.minor[1] + wz * k.minor[2];
-  perm = fabs(wx) * k.permanent[0] + fabs(wy) * k.permanent[1] + fabs(wz) * k.permanent[2];
-  if (perm >= detail::kMinPermanent &&
-      fabs(det) > detail::kOrient3dBound * perm + detail::kUnderflowSlack)
-    return detail::sign_of(det);
-  return Sign::uncertain;
+  return row_side_filter(k, d - a, perm);
 }
 
 /// Sign of det[b - a, c - a, d - a] from the plane's coefficients (k = PlaneCoefficients::of(a, b,
@@ -195,7 +208,6 @@ struct FilteredPredicates {
     return {PlaneCoefficients::of(pa, pb, pc), pa, pb, pc, positions};
   }
 };
-
 
 /// The signs of the plain double evaluation with no error bound, zero only when the rounded
 /// determinant is zero: what `--exact off` decides the filter's uncertain tests with. The same
