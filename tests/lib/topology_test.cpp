@@ -118,7 +118,10 @@ void expect_matches_brute_force(const std::vector<geom::Tri>& triangles, int32_t
     }
   EXPECT_EQ(topo.neighbor_pairs, pairs);
   EXPECT_EQ(topo.neighbor_shared, shared);
-  EXPECT_EQ(topo.self_neighbors, (std::vector<int64_t>{0, static_cast<int64_t>(pairs.size())}));
+  std::vector<int64_t> begin(static_cast<size_t>(n) + 1, 0);
+  for (const auto& [a, b] : pairs) ++begin[a + 1];
+  for (int32_t t = 0; t < n; ++t) begin[t + 1] += begin[t];
+  EXPECT_EQ(topo.neighbor_begin, begin);
 }
 
 TEST(Topology, EdgesOwnershipAndNeighbourPairsMatchBruteForce) {

@@ -138,9 +138,8 @@ void make_neighbor_pairs(Topology& topo) {
   }
 }
 
-/// Keeps the neighbour pairs of the parts checked against themselves and records each part's
-/// range. Pairs never join two parts, and sorted pairs of one part are contiguous, as its
-/// triangles are.
+/// Keeps the neighbour pairs of the parts checked against themselves and records where each
+/// triangle's pairs begin (the list is sorted by its first triangle).
 void select_self_neighbors(Topology& topo) {
   const int32_t parts = topo.part_count();
   std::vector<uint8_t> self(static_cast<size_t>(parts), 0);
@@ -148,20 +147,20 @@ void select_self_neighbors(Topology& topo) {
     if (c.self()) self[c.a] = 1;
   std::vector<std::array<int32_t, 2>> kept_pairs;
   std::vector<uint8_t> kept_shared;
-  topo.self_neighbors.assign(2 * static_cast<size_t>(parts), 0);
+  const int32_t n = topo.triangle_count();
+  topo.neighbor_begin.assign(static_cast<size_t>(n) + 1, 0);
   size_t i = 0;
-  const size_t n = topo.neighbor_pairs.size();
-  for (int32_t p = 0; p < parts; ++p) {
-    const int32_t end = topo.layout.triangle_begin[p + 1];
-    topo.self_neighbors[2 * p] = static_cast<int64_t>(kept_pairs.size());
-    for (; i < n && topo.neighbor_pairs[i][0] < end; ++i)
-      if (self[p]) {
-        kept_pairs.push_back(topo.neighbor_pairs[i]);
-        kept_shared.push_back(topo.neighbor_shared[i]);
-      }
-    topo.self_neighbors[2 * p + 1] = static_cast<int64_t>(kept_pairs.size());
-  }
-  if (kept_pairs.size() != n) {
+  const size_t count = topo.neighbor_pairs.size();
+  for (int32_t p = 0; p < parts; ++p)
+    for (int32_t t = topo.layout.triangle_begin[p]; t < topo.layout.triangle_begin[p + 1]; ++t) {
+      for (; i < count && topo.neighbor_pairs[i][0] == t; ++i)
+        if (self[p]) {
+          kept_pairs.push_back(topo.neighbor_pairs[i]);
+          kept_shared.push_back(topo.neighbor_shared[i]);
+        }
+      topo.neighbor_begin[t + 1] = static_cast<int64_t>(kept_pairs.size());
+    }
+  if (kept_pairs.size() != count) {
     topo.neighbor_pairs = std::move(kept_pairs);
     topo.neighbor_shared = std::move(kept_shared);
   }

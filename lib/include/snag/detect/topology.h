@@ -81,13 +81,15 @@ struct Topology {
   std::vector<int32_t> fan_begin;  ///< vertex_count + 1 offsets
   std::vector<FanStep> fan_steps;
 
+  /// Triangle t's neighbour pairs (t, x), x > t: neighbor_pairs[neighbor_begin[t] ..
+  /// neighbor_begin[t + 1]) (triangle_count + 1 offsets). A part's triangles being
+  /// contiguous, so are its pairs; a part not checked against itself has none listed.
+  std::vector<int64_t> neighbor_begin;
+
   /// The parts (one for a single mesh) and the checks between them, in increasing (a, b).
-  /// Neighbour pairs never join two parts (they share no vertex); those of part p's self
-  /// check are neighbor_pairs[self_neighbors[2 p] .. self_neighbors[2 p + 1]), an empty range
-  /// when p is not checked against itself (its pairs are then not listed at all).
+  /// Neighbour pairs never join two parts (they share no vertex).
   PartLayout layout;
   std::vector<PartCheck> checks = {PartCheck{}};
-  std::vector<int64_t> self_neighbors;
 
   int32_t triangle_count() const { return static_cast<int32_t>(triangles.size()); }
   int32_t part_count() const { return layout.part_count(); }
