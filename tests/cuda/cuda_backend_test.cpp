@@ -397,6 +397,29 @@ TEST(CudaDetect, ExactModesMatchTheCpuAndBruteForce) {
   }
 }
 
+// A sliver the rounded scan of `--exact off` flags degenerate although its fan is certified
+// clear (tests/lib/fan_test.cpp): both backends leave its pairs out of the candidates.
+TEST(CudaDetect, RoundedDegenerateSliverCountsAsOnTheCpu) {
+  SNAG_REQUIRE_GPU();
+  const double q = 1.0001905782366804, r = 1.0039064563594176, s = 1.0040977790816628;
+  const SmallMesh mesh{{{0, 0, 0}, {1, q, q}, {r, s, s}, {0, 1, 1}, {1, 0, 0}},
+                       {{{1, 2, 0}}, {{0, 4, 1}}, {{0, 2, 3}}}};
+  detect::CheckSettings settings;
+  settings.exact = detect::ExactMode::off;
+  auto run = [&](std::unique_ptr<detect::Backend> backend) {
+    detect::Checker checker(std::move(backend), nullptr, settings);
+    checker.set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+    return checker.check(mesh.positions);
+  };
+  const detect::FrameResult gpu = run(gpu_backend()), cpu = run(detect::make_cpu_backend(2));
+  EXPECT_EQ(gpu.degenerate, std::vector<int32_t>{0});
+  EXPECT_EQ(gpu.degenerate, cpu.degenerate);
+  EXPECT_EQ(gpu.candidate_pairs, 1);
+  EXPECT_EQ(gpu.candidate_pairs, cpu.candidate_pairs);
+  EXPECT_EQ(gpu.filtered_tests, cpu.filtered_tests);
+  EXPECT_EQ(gpu.pairs, cpu.pairs);
+}
+
 TEST(CudaBackend, EmptyAndSingleTriangleMeshes) {
   SNAG_REQUIRE_GPU();
   SmallMesh empty;

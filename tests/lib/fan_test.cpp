@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "detect_cases.h"
+#include "snag/detect/checker.h"
+#include "snag/detect/cpu_backend.h"
 #include "snag/detect/fan.h"
 #include "snag/detect/pair_test.h"
 #include "snag/detect/topology.h"
@@ -201,6 +203,25 @@ TEST(Fan, ClearFansHaveNoIntersectingPairOnRandomFans) {
   EXPECT_GT(intersecting, tried / 10);
   std::printf("fans: %d tried, %d cleared, %d with an intersecting pair\n", tried, cleared,
               intersecting);
+}
+
+// Under `--exact off` the rounded scan may flag degenerate a sliver whose fan the filter
+// certifies clear (its area is not zero). Degenerate triangles are no candidates: the CPU's
+// skip of a triangle whose corners all have clear fans must not count that sliver's pairs,
+// so that both backends count the same. (Found by review: q r rounds to s, the sliver's
+// corners lie 2^-53 off a line in the plane y = z.)
+TEST(Fan, RoundedDegenerateSliverIsNoCandidate) {
+  const double q = 1.0001905782366804, r = 1.0039064563594176, s = 1.0040977790816628;
+  const SmallMesh mesh{{{0, 0, 0}, {1, q, q}, {r, s, s}, {0, 1, 1}, {1, 0, 0}},
+                       {{{1, 2, 0}}, {{0, 4, 1}}, {{0, 2, 3}}}};
+  detect::CheckSettings settings;
+  settings.exact = detect::ExactMode::off;
+  detect::Checker checker(detect::make_cpu_backend(2), nullptr, settings);
+  checker.set_triangles(mesh.triangles, int32_t(mesh.positions.size()));
+  const detect::FrameResult result = checker.check(mesh.positions);
+  ASSERT_EQ(result.degenerate, std::vector<int32_t>{0});  // the sliver, by rounding
+  EXPECT_EQ(result.candidate_pairs, 1);                   // (1, 2) alone: both keep their area
+  EXPECT_TRUE(result.pairs.empty());
 }
 
 }  // namespace

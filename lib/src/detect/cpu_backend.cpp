@@ -331,6 +331,9 @@ class CpuBackend final : public Backend {
     const WalkInput in{trees_[part].view(),    base, {}, 0, &frame_view, &view,
                        degenerate_flags.data()};
     const int32_t end = topo.layout.triangle_begin[part + 1];
+    const bool any_degenerate =
+        std::find(degenerate_flags.begin() + base, degenerate_flags.begin() + end, 1) !=
+        degenerate_flags.begin() + end;
 #pragma omp parallel num_threads(threads_)
     {
       ThreadSink& sink = sinks[static_cast<size_t>(omp_get_thread_num())];
@@ -339,9 +342,11 @@ class CpuBackend final : public Backend {
         const int64_t first = topo.neighbor_begin[t], last = topo.neighbor_begin[t + 1];
         if (first == last) continue;
         // Every pair of t shares one of its corners: when all three have clear fans, no pair of
-        // t can intersect, and none of its neighbours is degenerate (a clear fan's triangles
-        // have certified nonzero area), so all count as candidates.
-        if (frame_view.fan_clear) {
+        // t can intersect. In a frame with no degenerate triangle all of them count as
+        // candidates at once. (A clear fan's triangles have certified nonzero area, but under
+        // `--exact off` the rounded scan may still flag one of them degenerate, and degenerate
+        // triangles are no candidates: such frames count pair by pair, as the GPU does.)
+        if (frame_view.fan_clear && !any_degenerate) {
           const geom::Tri tri = topo.triangles[t];
           if (frame_view.fan_clear[tri.v[0]] & frame_view.fan_clear[tri.v[1]] &
               frame_view.fan_clear[tri.v[2]]) {

@@ -105,9 +105,11 @@ void make_neighbor_pairs(Topology& topo) {
     if (c.self()) self_part[c.a] = 1;
   topo.fan_begin.assign(static_cast<size_t>(topo.vertex_count) + 1, 0);
   topo.fan_steps.clear();
+  // FanStep::face holds 2 t + 1: meshes of 2^30 triangles or more get no fans.
+  const bool fans_fit = n < (int32_t{1} << 30);
   for (int32_t p = 0; p < topo.part_count(); ++p)
     for (int32_t v = topo.layout.vertex_begin[p]; v < topo.layout.vertex_begin[p + 1]; ++v) {
-      if (self_part[p] && topo.listed_vertex[v])
+      if (fans_fit && self_part[p] && topo.listed_vertex[v])
         append_fan(topo, v,
                    std::span<const int32_t>(fan.data() + offsets[v], fan.data() + offsets[v + 1]));
       topo.fan_begin[v + 1] = static_cast<int32_t>(topo.fan_steps.size());
