@@ -15,6 +15,15 @@ struct EdgeRecord {
   int32_t corner;  // the triangle's edge k joins corners k and k + 1
 };
 
+/// Per part: 1 when it is checked against itself (its neighbour pairs are listed, its
+/// vertices get fans).
+std::vector<uint8_t> self_checked_parts(const Topology& topo) {
+  std::vector<uint8_t> self(static_cast<size_t>(topo.part_count()), 0);
+  for (const PartCheck& c : topo.checks)
+    if (c.self()) self[c.a] = 1;
+  return self;
+}
+
 /// The fan of vertex v (Topology::fan_steps) from its usable triangles `around` (increasing
 /// ids, at most kMaxListedValence), appended to topo.fan_steps; nothing when they do not form
 /// one strip around v or form one too short to hold a pair.
@@ -64,7 +73,7 @@ void append_fan(Topology& topo, int32_t v, std::span<const int32_t> around) {
     if (at < 0) break;  // the strip ended before taking every triangle: more than one strip
   }
   const bool whole =
-      topo.fan_steps.size() - begin == static_cast<size_t>(k) && (closed ? corner == start : true);
+      topo.fan_steps.size() - begin == static_cast<size_t>(k) && (!closed || corner == start);
   if (!whole) {
     topo.fan_steps.resize(begin);
     return;
@@ -100,9 +109,7 @@ void make_neighbor_pairs(Topology& topo) {
       topo.listed_vertex[v] = 1;
   }
   // The fans of the listed vertices of parts checked against themselves.
-  std::vector<uint8_t> self_part(static_cast<size_t>(topo.part_count()), 0);
-  for (const PartCheck& c : topo.checks)
-    if (c.self()) self_part[c.a] = 1;
+  const std::vector<uint8_t> self_part = self_checked_parts(topo);
   topo.fan_begin.assign(static_cast<size_t>(topo.vertex_count) + 1, 0);
   topo.fan_steps.clear();
   // FanStep::face holds 2 t + 1: meshes of 2^30 triangles or more get no fans.
@@ -144,9 +151,7 @@ void make_neighbor_pairs(Topology& topo) {
 /// triangle's pairs begin (the list is sorted by its first triangle).
 void select_self_neighbors(Topology& topo) {
   const int32_t parts = topo.part_count();
-  std::vector<uint8_t> self(static_cast<size_t>(parts), 0);
-  for (const PartCheck& c : topo.checks)
-    if (c.self()) self[c.a] = 1;
+  const std::vector<uint8_t> self = self_checked_parts(topo);
   std::vector<std::array<int32_t, 2>> kept_pairs;
   std::vector<uint8_t> kept_shared;
   const int32_t n = topo.triangle_count();
