@@ -121,6 +121,9 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.fan_begin, topology.fan_begin.data(), d.has_fans ? topology.fan_begin.size() : 0, s);
     upload(d.fan_steps, topology.fan_steps.data(), topology.fan_steps.size(), s);
     d.fan_clear.reserve(std::max<size_t>(d.has_fans ? d.vertex_count : 0, 1));
+    for (auto* masks : {&later_neighbors_, &frame_drop_mask_})
+      masks->reserve(std::max<size_t>(d.has_fans ? n : 0, 1));
+    leaf_position_.reserve(std::max<size_t>(d.has_fans ? n : 0, 1));
     d.frame_owned_edges.reserve(std::max<size_t>(n, 1));
     d.degenerate.reserve(std::max<size_t>(n, 1));
     d.degenerate_list.reserve(std::max<size_t>(n, 1));
@@ -342,6 +345,11 @@ class CudaBackendImpl final : public CudaBackend {
     }
     build_timer_.start(stream());
     trees_[p]->build(part_mesh(p), planes_.data() + part_begin(p), stream());
+    if (topo_.has_fans)
+      launch_later_neighbors(trees_[p]->view(), part_begin(p), topo_.triangles.data(),
+                             {topo_.fan_begin.data(), topo_.fan_steps.data()},
+                             leaf_position_.data() + part_begin(p), later_neighbors_.data(),
+                             stream());
     build_timer_.stop_async(stream());
     build_pending_ = true;
   }
@@ -666,6 +674,10 @@ class CudaBackendImpl final : public CudaBackend {
   const geom::Vec3d* current_positions_ = nullptr;
   int resident_count_ = 0;
   DeviceBuffer<geom::PlaneCoefficients> planes_;
+  // Per triangle of a part with fans, as its tree's leaf positions: NeighborDrop's later and
+  // frame masks; leaf_position_ is launch_later_neighbors' scratch.
+  DeviceBuffer<uint64_t> later_neighbors_, frame_drop_mask_;
+  DeviceBuffer<int32_t> leaf_position_;
   PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
@@ -758,6 +770,13 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
                   {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
                   topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data(), s);
     }
+  // Fan-cleared neighbours left out of the lists, in frames with no degenerate triangle: a
+  // clear fan's triangles have certified nonzero area, but `--exact off` may still flag one,
+  // and then some of the pairs left out would not have been candidates.
+  NeighborDrop drop;
+  if (fans && flagged_.empty())
+    drop = {later_neighbors_.data(), topo_.triangles.data(), topo_.fan_clear.data(),
+            frame_drop_mask_.data()};
   PairInputs inputs;
   inputs.frame = {current_positions_, planes_.data(), fans ? topo_.fan_clear.data() : nullptr};
   inputs.topology.triangles = topo_.triangles.data();
@@ -799,8 +818,8 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
           cudaMemsetAsync(&counters_.data()->listed, 0, 3 * sizeof(unsigned long long), s));
     if (check.self()) {
       if (part_size(check.a) > 0)
-        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, subwalks, listed,
-                          results, use, max_blocks_, s);
+        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, drop, subwalks,
+                          listed, results, use, max_blocks_, s);
     } else {
       // One thread per leaf of the larger part, walking the smaller one's tree.
       const bool a_larger = part_size(check.a) >= part_size(check.b);

@@ -135,6 +135,36 @@ __global__ void fans_kernel(const geom::Vec3d* positions, const geom::PlaneCoeff
   if (i < n) fan_clear[first + i] = detect::fan_is_clear(positions, planes, fans, first + i);
 }
 
+/// position_of_triangle[triangle_at[p]] = p for every leaf position p of a tree over n
+/// triangles (ids local to its part).
+__global__ void leaf_positions_kernel(const int32_t* triangle_at, int32_t n,
+                                      int32_t* position_of_triangle) {
+  wait_for_previous_kernel();
+  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (p < n) position_of_triangle[triangle_at[p]] = p;
+}
+
+/// later[base + p], per leaf position p: bit d set when the leaf at p + 1 + d holds a triangle of the
+/// fan of one of p's triangle's corners (its neighbours through a vertex with a fan, within
+/// the 64 positions after p).
+__global__ void later_neighbors_kernel(const int32_t* triangle_at, int32_t n, int32_t base,
+                                       const geom::Tri* triangles, detect::FanView fans,
+                                       const int32_t* position_of_triangle, uint64_t* later) {
+  wait_for_previous_kernel();
+  const int32_t p = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  if (p >= n) return;
+  const geom::Tri tri = triangles[base + triangle_at[p]];
+  uint64_t mask = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int32_t s = fans.begin[tri.v[k]], end = fans.begin[tri.v[k] + 1]; s < end; ++s) {
+      const int32_t face = fans.steps[s].face;
+      if (face < 0) continue;
+      const auto d = static_cast<uint32_t>(position_of_triangle[(face >> 1) - base] - p - 1);
+      if (d < 64) mask |= uint64_t{1} << d;
+    }
+  later[base + p] = mask;
+}
+
 /// A walk's listing (of candidate pairs, or of subwalks): its thread's keys held in a small
 /// local array and appended to the list a chunk at a time. Appending each key on its own
 /// serialised the walks on the list's counter. A full chunk, met inside the walk's divergent
@@ -192,11 +222,22 @@ class KeyLister {
 /// triangles and shared corners are the pair tests' business, so the walks are box tests only.
 __global__ void __launch_bounds__(kNarrowBlock)
     self_walk_kernel(bvh::TreeView tree, int32_t base, int32_t first_unopened,
-                     const uint8_t* degenerate, SubwalkList subwalks, FrameCounters* counters) {
+                     const uint8_t* degenerate, NeighborDrop drop, SubwalkList subwalks,
+                     FrameCounters* counters) {
   wait_for_previous_kernel();
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
-  if (degenerate[base + tree.triangle_at[position]]) return;
+  const int32_t t = base + tree.triangle_at[position];
+  if (drop.later) {
+    // This frame's share of the leaf's later neighbours that its subwalks leave out: all of
+    // them when its three corners have clear fans, else none. (Loaded beside the walk, whose
+    // chain of box tests hides them.)
+    const geom::Tri tri = drop.triangles[t];
+    const bool clear = drop.fan_clear[tri.v[0]] & drop.fan_clear[tri.v[1]] &
+                       drop.fan_clear[tri.v[2]];
+    drop.frame_mask[base + position] = clear ? drop.later[base + position] : 0;
+  }
+  if (degenerate[t]) return;
   KeyLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
   bvh::for_each_later_overlapping_leaf(
       tree, position, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
@@ -226,8 +267,9 @@ __global__ void __launch_bounds__(kNarrowBlock)
 /// the walks' count is known, on a grid for the count expected (SubwalkList::expected): one
 /// subwalk per thread, striding past that when there are more.
 __global__ void __launch_bounds__(kBlock)
-    subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, SubwalkList subwalks,
-                   CandidateList listed, FrameCounters* counters) {
+    subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked,
+                   const uint64_t* drop_mask, SubwalkList subwalks, CandidateList listed,
+                   FrameCounters* counters) {
   wait_for_previous_kernel();
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
@@ -235,16 +277,25 @@ __global__ void __launch_bounds__(kBlock)
   if (first == 0) atomicMax(&counters->subwalks_most, count);
   const unsigned long long stored = min(count, subwalks.capacity);
   KeyLister lister(listed.pairs, listed.capacity, &counters->listed);
+  unsigned long long dropped = 0;
   for (unsigned long long i = first; i < stored; i += stride) {
     const uint64_t walk = subwalks.walks[i];
     const auto position = static_cast<int32_t>(walk >> 32);
     const auto node = static_cast<int32_t>(walk & 0xffffffffu);
     const int32_t t = base + tree.triangle_at[position];
     const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-    bvh::for_each_overlapping_leaf_under(walked, node, box,
-                                         [&](int32_t leaf) { lister.add(pack(t, leaf)); });
+    const uint64_t mask = drop_mask ? drop_mask[base + position] : 0;
+    bvh::for_each_overlapping_leaf_under(walked, node, box, [&](int32_t leaf) {
+      // Bit d of the mask: the leaf at position + 1 + d is a neighbour cleared by a fan.
+      const auto d = static_cast<uint32_t>(walked.shape.position_of(leaf) - position - 1);
+      if (d < 64 && (mask >> d & 1u))
+        ++dropped;
+      else
+        lister.add(pack(t, leaf));
+    });
   }
   lister.finish();
+  add_warp_total(dropped, &counters->candidates);
 }
 
 /// Calls visit(t, x) for each pair of the current check's list whose x (the leaf's triangle,
@@ -490,6 +541,17 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
   launch_chained_items(planes_kernel, n, stream, positions, triangles, n, planes);
 }
 
+void launch_later_neighbors(const bvh::TreeView& tree, int32_t base, const geom::Tri* triangles,
+                            detect::FanView fans, int32_t* position_of_triangle, uint64_t* later,
+                            cudaStream_t stream) {
+  const int32_t n = tree.shape.leaf_count;
+  if (n <= 0) return;
+  launch_chained_items(leaf_positions_kernel, n, stream, tree.triangle_at, n,
+                       position_of_triangle);
+  launch_chained_items(later_neighbors_kernel, n, stream, tree.triangle_at, n, base, triangles,
+                       fans, position_of_triangle, later);
+}
+
 void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
                  detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
                  cudaStream_t stream) {
@@ -536,10 +598,11 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
 /// rather than the capacity, which only grows: a heavy frame does not leave every later check
 /// launching thousands of idle blocks.
 void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
-                     const SubwalkList& subwalks, const CandidateList& listed,
-                     const ResultBuffers& results, cudaStream_t stream) {
+                     const uint64_t* drop_mask, const SubwalkList& subwalks,
+                     const CandidateList& listed, const ResultBuffers& results,
+                     cudaStream_t stream) {
   launch_counted(subwalk_kernel, std::min(subwalks.expected, subwalks.capacity), ~0u, stream, tree,
-                 base, walked, subwalks, listed, results.counters);
+                 base, walked, drop_mask, subwalks, listed, results.counters);
 }
 
 unsigned walk_blocks(const bvh::TreeView& tree) {
@@ -549,15 +612,16 @@ unsigned walk_blocks(const bvh::TreeView& tree) {
 }  // namespace
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const SubwalkList& subwalks, const CandidateList& listed,
-                       const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
-                       cudaStream_t stream) {
+                       const NeighborDrop& drop, const SubwalkList& subwalks,
+                       const CandidateList& listed, const ResultBuffers& results,
+                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(tree.shape));
   launch_chained(self_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree, base,
-                 first_unopened, inputs.degenerate, subwalks, results.counters);
-  launch_subwalks(tree, base, tree, subwalks, listed, results, stream);
+                 first_unopened, inputs.degenerate, drop, subwalks, results.counters);
+  launch_subwalks(tree, base, tree, drop.later ? drop.frame_mask : nullptr, subwalks, listed,
+                  results, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
 
@@ -569,7 +633,7 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
   launch_chained(cross_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree,
                  base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
-  launch_subwalks(tree, base_a, other, subwalks, listed, results, stream);
+  launch_subwalks(tree, base_a, other, nullptr, subwalks, listed, results, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
 

@@ -137,6 +137,22 @@ struct ResultBuffers {
   const int32_t* edge_face_offsets = nullptr;
 };
 
+/// What a self check's subwalks leave out: the leaves of a triangle's neighbours when its
+/// three corners have clear fans (detect/fan.h). Such a pair shares a clear vertex, so its test
+/// would end at once (detect::cleared_by_fan): left out of the list, it is counted as a
+/// candidate and never screened. A triangle's later neighbours within 64 leaf positions are
+/// known per tree build (`later`, launch_later_neighbors: 80% of a settled 36K cloth's); the
+/// walk kernel keeps, per frame, those of the leaves whose corners are all clear in
+/// `frame_mask`, which the subwalks read. Null `later`: nothing is left out (no fans, the
+/// filter deferred, or a frame with degenerate triangles, which are no candidates).
+/// Arrays indexed by the topology's triangle range of the part: base + leaf position.
+struct NeighborDrop {
+  const uint64_t* later = nullptr;
+  const geom::Tri* triangles = nullptr;
+  const uint8_t* fan_clear = nullptr;
+  uint64_t* frame_mask = nullptr;
+};
+
 /// Everything the pair tests of one frame read.
 struct PairInputs {
   detect::FrameView frame;
@@ -170,6 +186,13 @@ void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* pl
                  detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
                  cudaStream_t stream);
 
+/// For a tree just built over a part whose first triangle is `base`: later[base + p], per leaf
+/// position p, has bit d set when the leaf at p + 1 + d holds a triangle of the fan of a corner
+/// of p's triangle (NeighborDrop). position_of_triangle (the part's size) is scratch.
+void launch_later_neighbors(const bvh::TreeView& tree, int32_t base, const geom::Tri* triangles,
+                            detect::FanView fans, int32_t* position_of_triangle, uint64_t* later,
+                            cudaStream_t stream);
+
 /// planes[t] = the plane of triangle t (detect::triangle_plane). The refit computes them too; this
 /// is for frames whose tree was not refit to the current positions.
 void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int32_t n,
@@ -195,11 +218,12 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// test kernel of its own: it computes no sides to screen with. The subwalks run one per
 /// thread; the screen on one wave of its blocks (at most `max_blocks`) striding over the list,
 /// and the whole test on a grid for the pairs expected (CandidateList::screened_expected, at
-/// most `max_blocks` blocks) striding over the pairs kept.
+/// most `max_blocks` blocks) striding over the pairs kept. `drop`: the fan-cleared neighbours
+/// the subwalks leave out (NeighborDrop).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const SubwalkList& subwalks, const CandidateList& listed,
-                       const ResultBuffers& results, detect::FilterUse use, unsigned max_blocks,
-                       cudaStream_t stream);
+                       const NeighborDrop& drop, const SubwalkList& subwalks,
+                       const CandidateList& listed, const ResultBuffers& results,
+                       detect::FilterUse use, unsigned max_blocks, cudaStream_t stream);
 
 /// Two parts, the same way: one thread per leaf of `tree` (part a, whose first triangle is
 /// base_a) walking all of `other` (part b) down to its split level, the subwalks under the

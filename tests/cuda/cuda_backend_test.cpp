@@ -420,6 +420,49 @@ TEST(CudaDetect, RoundedDegenerateSliverCountsAsOnTheCpu) {
   EXPECT_EQ(gpu.pairs, cpu.pairs);
 }
 
+// A sheet rippled more every frame (refit, not rebuilt): at first every vertex's fan is clear
+// and the subwalks leave nearly all neighbour pairs out of their lists (NeighborDrop); a frame
+// with zero-area faces turns the leaving out off; at last the sheet folds through itself and
+// fewer fans stay clear. Candidates, filtered tests and pairs are the CPU's in every frame, the
+// pairs brute force's, and every neighbour pair is counted a candidate (their boxes touch).
+TEST(CudaDetect, FanClearedNeighboursLeftOutCountAsOnTheCpu) {
+  SNAG_REQUIRE_GPU();
+  const int w = 50, h = 40;
+  auto sheet = [&](double amplitude) {
+    return grid_mesh(w, h, [&](int i, int j) {
+      return geom::Vec3d{10.0 * i + j % 3, 10.0 * j,
+                         std::round(amplitude * std::sin(i * 0.45) * std::cos(j * 0.3))};
+    });
+  };
+  const SmallMesh flat = sheet(0);
+  const detect::Topology topology =
+      detect::make_topology(flat.triangles, static_cast<int32_t>(flat.positions.size()));
+  ASSERT_FALSE(topology.fan_steps.empty());
+  const int64_t neighbour_pairs = topology.neighbor_begin.back();
+  auto cpu = detect::make_cpu_backend(2);
+  auto gpu = gpu_backend();
+  cpu->set_topology(topology);
+  gpu->set_topology(topology);
+  SmallMesh degenerate = sheet(4);
+  degenerate.positions[degenerate.triangles[500].v[0]] =
+      degenerate.positions[degenerate.triangles[500].v[1]];
+  const std::vector<std::pair<std::string, SmallMesh>> frames = {
+      {"flat", flat},           {"ripples 4", sheet(4)}, {"zero-area faces", degenerate},
+      {"ripples 12", sheet(12)}, {"ripples 40", sheet(40)}, {"folded", folded_grid(w, h)}};
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const auto& [what, mesh] = frames[f];
+    const Filtered c = filtered(*cpu, mesh.positions, f == 0);
+    const Filtered g = filtered(*gpu, mesh.positions, f == 0);
+    expect_same(c, g, what);
+    if (what != "zero-area faces") EXPECT_EQ(g.frame.pairs.empty(), what != "folded") << what;
+    if (g.scan.degenerate.empty())
+      EXPECT_GE(g.frame.candidate_pairs, neighbour_pairs) << what;
+    else
+      EXPECT_EQ(what, "zero-area faces");
+    if (f + 2 >= frames.size()) EXPECT_EQ(check_on_gpu(mesh).pairs, brute_force(mesh)) << what;
+  }
+}
+
 TEST(CudaBackend, EmptyAndSingleTriangleMeshes) {
   SNAG_REQUIRE_GPU();
   SmallMesh empty;
