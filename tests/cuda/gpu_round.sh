@@ -33,7 +33,7 @@ for step in "${steps[@]}"; do
       racecheck_filter='CudaDetect.HandBuilt*:CudaDetect.MoreResults*:CudaBackend.EmptyAndSingle*:CudaScene.ScenesMatchTheCpuAndBruteForce*'
       for tool in memcheck racecheck; do
         filter=$memcheck_filter; [ $tool = racecheck ] && filter=$racecheck_filter
-        timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
+        timeout ${SANITIZE_TIMEOUT:-400} compute-sanitizer --tool $tool --error-exitcode 97 snag_cuda_tests --gtest_brief=1 \
           --gtest_filter="$filter" >"$out/sanitize_$tool.log" 2>&1; rc=$?
         summary+=("$tool         rc=$rc $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitize_$tool.log" | tail -1) $(grep -E '^\[  (PASSED|FAILED) ' "$out/sanitize_$tool.log" | tr '\n' ' ')")
       done
