@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# One round on a GPU machine, from the repository root, with the build staged by
-# ../shared/gpu/stage into .gpu (see tests/cuda/README in the final report):
+# One round on a GPU machine, from the repository root, with the build staged into .gpu by
+# tests/cuda/stage.sh (here: tests/cuda/stage.sh build-gpu), carried as .gpu:
 #   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [accuracy] [io]
 # Logs go to $OUT (or ./out); a short table is printed last.
 set -uo pipefail
