@@ -232,10 +232,8 @@ __global__ void __launch_bounds__(kNarrowBlock)
     // This frame's share of the leaf's later neighbours that its subwalks leave out: all of
     // them when its three corners have clear fans, else none. (Loaded beside the walk, whose
     // chain of box tests hides them.)
-    const geom::Tri tri = drop.triangles[t];
-    const bool clear = drop.fan_clear[tri.v[0]] & drop.fan_clear[tri.v[1]] &
-                       drop.fan_clear[tri.v[2]];
-    drop.frame_mask[base + position] = clear ? drop.later[base + position] : 0;
+    drop.frame_mask[base + position] =
+        detect::corners_clear(drop.fan_clear, drop.triangles[t]) ? drop.later[base + position] : 0;
   }
   if (degenerate[t]) return;
   KeyLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);

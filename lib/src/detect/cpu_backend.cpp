@@ -346,13 +346,10 @@ class CpuBackend final : public Backend {
         // candidates at once. (A clear fan's triangles have certified nonzero area, but under
         // `--exact off` the rounded scan may still flag one of them degenerate, and degenerate
         // triangles are no candidates: such frames count pair by pair, as the GPU does.)
-        if (frame_view.fan_clear && !any_degenerate) {
-          const geom::Tri tri = topo.triangles[t];
-          if (frame_view.fan_clear[tri.v[0]] & frame_view.fan_clear[tri.v[1]] &
-              frame_view.fan_clear[tri.v[2]]) {
-            sink.candidates += last - first;
-            continue;
-          }
+        if (frame_view.fan_clear && !any_degenerate &&
+            corners_clear(frame_view.fan_clear, topo.triangles[t])) {
+          sink.candidates += last - first;
+          continue;
         }
         for (int64_t i = first; i < last; ++i) {
           const int32_t x = topo.neighbor_pairs[i][1];

@@ -93,4 +93,10 @@ SNAG_HD_INLINE bool cleared_by_fan(const uint8_t* fan_clear, const geom::Tri& t,
   return clear;
 }
 
+/// Whether all three corners of triangle t have clear fans this frame: then every pair of t
+/// with a triangle sharing one of its vertices is cleared_by_fan. (fan_clear not null.)
+SNAG_HD_INLINE bool corners_clear(const uint8_t* fan_clear, const geom::Tri& t) {
+  return (fan_clear[t.v[0]] & fan_clear[t.v[1]] & fan_clear[t.v[2]]) != 0;
+}
+
 }  // namespace snag::detect
