@@ -180,9 +180,11 @@ PairMultiset grouped_pairs(const TreeView& view) {
   PairMultiset pairs;
   int32_t first, last;
   group_range<W>(view.shape, first, last);
-  for (int32_t group = first; group < last; ++group)
-    for_each_later_overlap_grouped<W>(view, group, [&](int32_t t, int32_t x) {
-      pairs.insert({std::min(t, x), std::max(t, x)});
+  for (int32_t node = first; node < last; ++node)
+    for_each_group_under<W>(view.shape, node, [&](int32_t group) {
+      for_each_later_overlap_grouped<W>(view, group, [&](int32_t t, int32_t x) {
+        pairs.insert({std::min(t, x), std::max(t, x)});
+      });
     });
   return pairs;
 }
@@ -350,6 +352,38 @@ TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
     }
     EXPECT_EQ(per_leaf.size(), static_cast<size_t>(n * (n - 1) / 2)) << "n=" << n;
   }
+}
+
+/// The groups of W leaves, for every n up to 5,000: each holds 1 to W leaves (at least W / 2
+/// once the tree has 2W), they cover the leaves once and in order, and, where the tree has
+/// levels enough, a group parent with exactly W leaves is one group.
+template <int W>
+void expect_groups_cover_leaves_in_order() {
+  for (int32_t n = 1; n <= 5000; ++n) {
+    const CompleteTree shape(n);
+    int32_t first, last, next = 0;
+    group_range<W>(shape, first, last);
+    for (int32_t node = first; node < last; ++node) {
+      int32_t parent_begin, parent_end, groups = 0;
+      shape.positions_under(node, parent_begin, parent_end);
+      for_each_group_under<W>(shape, node, [&](int32_t group) {
+        int32_t begin, end;
+        shape.positions_under(group, begin, end);
+        ASSERT_EQ(begin, next) << "W=" << W << " n=" << n << " group " << group;
+        ASSERT_GE(end - begin, n >= 2 * W ? W / 2 : 1) << "W=" << W << " n=" << n;
+        ASSERT_LE(end - begin, W) << "W=" << W << " n=" << n;
+        next = end;
+        ++groups;
+      });
+      if (parent_end - parent_begin == W) ASSERT_EQ(groups, 1) << "W=" << W << " n=" << n;
+    }
+    ASSERT_EQ(next, n) << "W=" << W << " n=" << n;
+  }
+}
+
+TEST(Traversal, GroupsCoverTheLeavesOnceInOrderForEveryNUpTo5000) {
+  expect_groups_cover_leaves_in_order<4>();
+  expect_groups_cover_leaves_in_order<8>();
 }
 
 TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {

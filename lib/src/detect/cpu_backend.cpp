@@ -391,7 +391,7 @@ class CpuBackend final : public Backend {
 
   /// Inside a parallel region: the `kind` walk of every group of in.tree at the chosen width
   /// (of 8 leaves through walk_group_avx2 where the CPU has AVX2), shared among the threads in
-  /// dynamic chunks of 256 leaves.
+  /// dynamic chunks of 128 / W group parents (128 to 256 leaves).
   template <GroupWalk kind, FilterUse use>
   void walk_groups(const WalkInput& in, ThreadSink& sink) const {
     if (wide_)
@@ -402,19 +402,21 @@ class CpuBackend final : public Backend {
 
   template <int W, GroupWalk kind, FilterUse use>
   void walk_groups_of(const WalkInput& in, ThreadSink& sink) const {
-    int32_t first_group, last_group;
-    bvh::group_range<W>(in.tree.shape, first_group, last_group);
-#pragma omp for schedule(dynamic, 256 / W)
-    for (int32_t group = first_group; group < last_group; ++group) {
+    int32_t first, last;
+    bvh::group_range<W>(in.tree.shape, first, last);
+#pragma omp for schedule(dynamic, 128 / W)
+    for (int32_t node = first; node < last; ++node) {
+      bvh::for_each_group_under<W>(in.tree.shape, node, [&](int32_t group) {
 #if defined(SNAG_HAVE_AVX2_WALK)
-      if constexpr (W == 8) {
-        if (avx2_) {
-          walk_group_avx2<kind, use>(in, group, sink);
-          continue;
+        if constexpr (W == 8) {
+          if (avx2_) {
+            walk_group_avx2<kind, use>(in, group, sink);
+            return;
+          }
         }
-      }
 #endif
-      walk_group<kind, W, use>(in, group, sink);
+        walk_group<kind, W, use>(in, group, sink);
+      });
     }
   }
 

@@ -26,20 +26,38 @@ namespace snag::bvh {
 template <int W>
 constexpr int kGroupShift = W == 8 ? 3 : 2;
 
-/// The level whose nodes are the groups of W leaves: D - log2(W), where every node is internal
-/// and holds W / 2 to W leaves (those of levels D - 1 and D below it); the root for a tree of
-/// fewer levels.
+/// The level of the nodes that hold the groups of W leaves: D - log2(W) - 1 (the root for a
+/// tree of fewer levels). A node there holds W to 2W leaves: exactly W when all of them are on
+/// level D - 1, and then it is one group; otherwise each of its two children (W / 2 to W
+/// leaves) is one (for_each_group_under). Groups on a single level would be half empty where
+/// most leaves are on level D - 1 (a 36K-leaf tree's groups of 8 held 4.4 leaves on average;
+/// these hold 8), and a walk costs about the same for a full group as for a half-empty one.
 template <int W>
-inline int32_t group_level(const CompleteTree& shape) {
-  return shape.depth >= kGroupShift<W> ? shape.depth - kGroupShift<W> : 0;
+inline int32_t group_parent_level(const CompleteTree& shape) {
+  return shape.depth > kGroupShift<W> ? shape.depth - kGroupShift<W> - 1 : 0;
 }
 
-/// The nodes of group_level<W>(): [first, last), in leaf order.
+/// The nodes of group_parent_level<W>(): [first, last), in leaf order.
 template <int W>
 inline void group_range(const CompleteTree& shape, int32_t& first, int32_t& last) {
-  const int32_t level = group_level<W>(shape);
+  const int32_t level = group_parent_level<W>(shape);
   first = CompleteTree::level_begin(level);
   last = std::min(CompleteTree::level_begin(level + 1), shape.node_count());
+}
+
+/// Calls f(group) for the groups of W leaves under `node` of group_range<W>(), in leaf order:
+/// the node itself when it holds at most W leaves, else its two children. Every leaf is in
+/// exactly one group, and the groups of all such nodes, in order, cover the leaves in order.
+template <int W, class F>
+inline void for_each_group_under(const CompleteTree& shape, int32_t node, F&& f) {
+  int32_t begin, end;
+  shape.positions_under(node, begin, end);
+  if (end - begin <= W) {
+    f(node);
+  } else {
+    f(2 * node + 1);
+    f(2 * node + 2);
+  }
 }
 
 /// W floats and W int32 as one vector each (explicit sizes: GCC ignores a vector_size that
@@ -57,7 +75,7 @@ struct LaneVectors<8> {
   typedef int32_t Ints __attribute__((vector_size(32)));
 };
 
-/// The (up to W) leaves under node `group` of group_level<W>() as SIMD lanes: their boxes and
+/// The (up to W) leaves under node `group` (for_each_group_under) as SIMD lanes: their boxes and
 /// triangles. Absent lanes get an empty box and are masked out.
 template <int W>
 struct LeafLanes {
@@ -150,13 +168,12 @@ struct LeafLanes {
   /// The query of for_each_later_overlap for every member at once (this group's node is
   /// `group`): calls visit_leaf(lane_bits, other_triangle) for every later leaf, with a bit for
   /// each member whose box overlaps it, so that each unordered pair is visited once. Pairs of
-  /// members come first, as (bit of the earlier member, later member's triangle).
+  /// members come first, as (bits of the earlier members, later member's triangle).
   template <class VisitLeaf>
   void for_each_later(const TreeView& tree, int32_t group, VisitLeaf&& visit_leaf) const {
-    for (int a = 0; a < members; ++a)
-      for (int b = a + 1; b < members; ++b)
-        if (geom::overlap(tree.boxes[leaf[a]], tree.boxes[leaf[b]]))
-          visit_leaf(1u << a, triangle[b]);
+    for (int b = 1; b < members; ++b)
+      if (const uint32_t earlier = overlaps(tree.boxes[leaf[b]]) & ((1u << b) - 1u))
+        visit_leaf(earlier, triangle[b]);
     // Members against the later subtrees: the right siblings of the group's left-child
     // ancestors.
     for (int32_t node = group; node > 0; node = (node - 1) >> 1)
@@ -165,7 +182,7 @@ struct LeafLanes {
 };
 
 /// The per-leaf query of for_each_later_overlap, run for the (up to W) leaves under node
-/// `group` of group_level<W>() at once: calls visit(member_triangle, other_triangle) for every
+/// `group` (for_each_group_under) at once: calls visit(member_triangle, other_triangle) for every
 /// pair of a member and a later leaf whose boxes overlap, each unordered pair once. The members
 /// share every ancestor above the group, so their walks through the later subtrees are one walk
 /// (LeafLanes::for_each_later). Memory: a few registers and the W boxes.
@@ -175,7 +192,7 @@ inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&&
   lanes.for_each_later(tree, group, lanes.each_lane(visit));
 }
 
-/// for_each_overlap for the (up to W) leaves under node `group` of `tree` (group_level<W>())
+/// for_each_overlap for the (up to W) leaves under node `group` of `tree` (for_each_group_under)
 /// against every leaf of `other`: calls visit(member_triangle, other_triangle) for every pair
 /// whose boxes overlap.
 template <int W, class Visit>
