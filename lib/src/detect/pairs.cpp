@@ -92,7 +92,7 @@ int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& t
   const geom::FilteredPredicates pred{positions.data()};
   int64_t uncertain = 0;
   const auto count = static_cast<int64_t>(pairs.size());
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : uncertain) if (count > 4096)
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : uncertain) if (count > 512)
   for (int64_t i = 0; i < count; ++i) {
     FacePair& pair = pairs[i];
     const geom::Tri& f = topo.triangles[pair.a];
