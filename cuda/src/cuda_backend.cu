@@ -121,8 +121,7 @@ class CudaBackendImpl final : public CudaBackend {
     upload(d.fan_begin, topology.fan_begin.data(), d.has_fans ? topology.fan_begin.size() : 0, s);
     upload(d.fan_steps, topology.fan_steps.data(), topology.fan_steps.size(), s);
     d.fan_clear.reserve(std::max<size_t>(d.has_fans ? d.vertex_count : 0, 1));
-    for (auto* masks : {&later_neighbors_, &frame_drop_mask_})
-      masks->reserve(std::max<size_t>(d.has_fans ? n : 0, 1));
+    later_neighbors_.reserve(std::max<size_t>(d.has_fans ? n : 0, 1));
     leaf_position_.reserve(std::max<size_t>(d.has_fans ? n : 0, 1));
     d.frame_owned_edges.reserve(std::max<size_t>(n, 1));
     d.degenerate.reserve(std::max<size_t>(n, 1));
@@ -674,9 +673,9 @@ class CudaBackendImpl final : public CudaBackend {
   const geom::Vec3d* current_positions_ = nullptr;
   int resident_count_ = 0;
   DeviceBuffer<geom::PlaneCoefficients> planes_;
-  // Per triangle of a part with fans, as its tree's leaf positions: NeighborDrop's later and
-  // frame masks; leaf_position_ is launch_later_neighbors' scratch.
-  DeviceBuffer<uint64_t> later_neighbors_, frame_drop_mask_;
+  // Per triangle of a part with fans, as its tree's leaf positions: NeighborDrop's later;
+  // leaf_position_ is launch_later_neighbors' scratch.
+  DeviceBuffer<uint64_t> later_neighbors_;
   DeviceBuffer<int32_t> leaf_position_;
   PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
@@ -759,24 +758,15 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
                     planes_.data() + part_begin(p), s);
       part.planes_version = part.version;
     }
-  // The fans of the parts checked against themselves, which their pair tests read.
+  // The fans of the parts checked against themselves, which their subwalks and pair tests read
+  // (each computed in its part's walk kernel: FanJob).
   const bool fans = use == detect::FilterUse::certify && topo_.has_fans;
-  if (fans)
-    for (int32_t c : checks) {
-      const detect::PartCheck check = topology_->checks[c];
-      if (!check.self() || part_size(check.a) == 0) continue;
-      const int32_t first = topology_->layout.vertex_begin[check.a];
-      launch_fans(current_positions_, planes_.data(),
-                  {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
-                  topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data(), s);
-    }
   // Fan-cleared neighbours left out of the lists, in frames with no degenerate triangle: a
   // clear fan's triangles have certified nonzero area, but `--exact off` may still flag one,
   // and then some of the pairs left out would not have been candidates.
   NeighborDrop drop;
   if (fans && flagged_.empty())
-    drop = {later_neighbors_.data(), topo_.triangles.data(), topo_.fan_clear.data(),
-            frame_drop_mask_.data()};
+    drop = {later_neighbors_.data(), topo_.triangles.data(), topo_.fan_clear.data()};
   PairInputs inputs;
   inputs.frame = {current_positions_, planes_.data(), fans ? topo_.fan_clear.data() : nullptr};
   inputs.topology.triangles = topo_.triangles.data();
@@ -817,9 +807,16 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
       SNAG_CUDA_CHECK(
           cudaMemsetAsync(&counters_.data()->listed, 0, 3 * sizeof(unsigned long long), s));
     if (check.self()) {
+      FanJob part_fans;
+      if (fans) {
+        const int32_t first = topology_->layout.vertex_begin[check.a];
+        part_fans = {current_positions_, planes_.data(),
+                     {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
+                     topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data()};
+      }
       if (part_size(check.a) > 0)
-        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, drop, subwalks,
-                          listed, results, use, max_blocks_, s);
+        launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, part_fans, drop,
+                          subwalks, listed, results, use, max_blocks_, s);
     } else {
       // One thread per leaf of the larger part, walking the smaller one's tree.
       const bool a_larger = part_size(check.a) >= part_size(check.b);

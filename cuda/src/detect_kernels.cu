@@ -128,13 +128,6 @@ __global__ void planes_kernel(const geom::Vec3d* positions, const geom::Tri* tri
   if (t < n) planes[t] = detect::triangle_plane(positions, triangles[t]);
 }
 
-__global__ void fans_kernel(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
-                            detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear) {
-  wait_for_previous_kernel();
-  const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (i < n) fan_clear[first + i] = detect::fan_is_clear(positions, planes, fans, first + i);
-}
-
 /// position_of_triangle[triangle_at[p]] = p for every leaf position p of a tree over n
 /// triangles (ids local to its part).
 __global__ void leaf_positions_kernel(const int32_t* triangle_at, int32_t n,
@@ -220,21 +213,27 @@ class KeyLister {
 /// (position, node) for every overlapping node at `first_unopened` or after (the split level
 /// and under it; see SubwalkList). Nothing is loaded at a node handed over: degenerate
 /// triangles and shared corners are the pair tests' business, so the walks are box tests only.
+/// The blocks past the walks' compute the part's fans (FanJob), one vertex per thread: the
+/// walks, at about two warps per scheduler, leave the SMs room for them.
 __global__ void __launch_bounds__(kNarrowBlock)
     self_walk_kernel(bvh::TreeView tree, int32_t base, int32_t first_unopened,
-                     const uint8_t* degenerate, NeighborDrop drop, SubwalkList subwalks,
+                     const uint8_t* degenerate, FanJob fans, SubwalkList subwalks,
                      FrameCounters* counters) {
   wait_for_previous_kernel();
+  const auto walk_blocks =
+      static_cast<int32_t>((tree.shape.leaf_count + blockDim.x - 1) / blockDim.x);
+  if (static_cast<int32_t>(blockIdx.x) >= walk_blocks) {
+    const int32_t v =
+        (static_cast<int32_t>(blockIdx.x) - walk_blocks) * static_cast<int32_t>(blockDim.x) +
+        static_cast<int32_t>(threadIdx.x);
+    if (v < fans.count)
+      fans.fan_clear[fans.first + v] =
+          detect::fan_is_clear(fans.positions, fans.planes, fans.fans, fans.first + v);
+    return;
+  }
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   const int32_t t = base + tree.triangle_at[position];
-  if (drop.later) {
-    // This frame's share of the leaf's later neighbours that its subwalks leave out: all of
-    // them when its three corners have clear fans, else none. (Loaded beside the walk, whose
-    // chain of box tests hides them.)
-    drop.frame_mask[base + position] =
-        detect::corners_clear(drop.fan_clear, drop.triangles[t]) ? drop.later[base + position] : 0;
-  }
   if (degenerate[t]) return;
   KeyLister lister(subwalks.walks, subwalks.capacity, &counters->subwalks);
   bvh::for_each_later_overlapping_leaf(
@@ -265,9 +264,8 @@ __global__ void __launch_bounds__(kNarrowBlock)
 /// the walks' count is known, on a grid for the count expected (SubwalkList::expected): one
 /// subwalk per thread, striding past that when there are more.
 __global__ void __launch_bounds__(kBlock)
-    subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked,
-                   const uint64_t* drop_mask, SubwalkList subwalks, CandidateList listed,
-                   FrameCounters* counters) {
+    subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, NeighborDrop drop,
+                   SubwalkList subwalks, CandidateList listed, FrameCounters* counters) {
   wait_for_previous_kernel();
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
@@ -282,7 +280,13 @@ __global__ void __launch_bounds__(kBlock)
     const auto node = static_cast<int32_t>(walk & 0xffffffffu);
     const int32_t t = base + tree.triangle_at[position];
     const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-    const uint64_t mask = drop_mask ? drop_mask[base + position] : 0;
+    // The leaf's later neighbours left out: all of them when its three corners have clear
+    // fans this frame, else none (NeighborDrop).
+    uint64_t mask = 0;
+    if (drop.later) {
+      const uint64_t later = drop.later[base + position];
+      mask = detect::corners_clear(drop.fan_clear, drop.triangles[t]) ? later : 0;
+    }
     bvh::for_each_overlapping_leaf_under(walked, node, box, [&](int32_t leaf) {
       // Bit d of the mask: the leaf at position + 1 + d is a neighbour cleared by a fan.
       const auto d = static_cast<uint32_t>(walked.shape.position_of(leaf) - position - 1);
@@ -550,12 +554,6 @@ void launch_later_neighbors(const bvh::TreeView& tree, int32_t base, const geom:
                        fans, position_of_triangle, later);
 }
 
-void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
-                 detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
-                 cudaStream_t stream) {
-  launch_chained_items(fans_kernel, n, stream, positions, planes, fans, first, n, fan_clear);
-}
-
 namespace {
 
 /// A launch whose item count is known only on the device, when it runs: a grid that covers
@@ -596,30 +594,32 @@ void launch_pair_tests(const PairInputs& inputs, const bvh::TreeView& walked, in
 /// rather than the capacity, which only grows: a heavy frame does not leave every later check
 /// launching thousands of idle blocks.
 void launch_subwalks(const bvh::TreeView& tree, int32_t base, const bvh::TreeView& walked,
-                     const uint64_t* drop_mask, const SubwalkList& subwalks,
+                     const NeighborDrop& drop, const SubwalkList& subwalks,
                      const CandidateList& listed, const ResultBuffers& results,
                      cudaStream_t stream) {
   launch_counted(subwalk_kernel, std::min(subwalks.expected, subwalks.capacity), ~0u, stream, tree,
-                 base, walked, drop_mask, subwalks, listed, results.counters);
+                 base, walked, drop, subwalks, listed, results.counters);
 }
 
-unsigned walk_blocks(const bvh::TreeView& tree) {
-  return static_cast<unsigned>((tree.shape.leaf_count + kNarrowBlock - 1) / kNarrowBlock);
+unsigned blocks_for(int32_t items, int block) {
+  return static_cast<unsigned>((static_cast<int64_t>(items) + block - 1) / block);
 }
 
 }  // namespace
 
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const NeighborDrop& drop, const SubwalkList& subwalks,
+                       const FanJob& fans, const NeighborDrop& drop, const SubwalkList& subwalks,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
+  // The fans' blocks follow the walks' (self_walk_kernel).
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(tree.shape));
-  launch_chained(self_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree, base,
-                 first_unopened, inputs.degenerate, drop, subwalks, results.counters);
-  launch_subwalks(tree, base, tree, drop.later ? drop.frame_mask : nullptr, subwalks, listed,
-                  results, stream);
+  const unsigned blocks = blocks_for(tree.shape.leaf_count, kNarrowBlock) +
+                          blocks_for(std::max(fans.count, 0), kNarrowBlock);
+  launch_chained(self_walk_kernel, dim3(blocks), dim3(kNarrowBlock), stream, tree, base,
+                 first_unopened, inputs.degenerate, fans, subwalks, results.counters);
+  launch_subwalks(tree, base, tree, drop, subwalks, listed, results, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
 
@@ -629,9 +629,10 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
                         detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
-  launch_chained(cross_walk_kernel, dim3(walk_blocks(tree)), dim3(kNarrowBlock), stream, tree,
-                 base_a, other, first_unopened, inputs.degenerate, subwalks, results.counters);
-  launch_subwalks(tree, base_a, other, nullptr, subwalks, listed, results, stream);
+  launch_chained(cross_walk_kernel, dim3(blocks_for(tree.shape.leaf_count, kNarrowBlock)),
+                 dim3(kNarrowBlock), stream, tree, base_a, other, first_unopened,
+                 inputs.degenerate, subwalks, results.counters);
+  launch_subwalks(tree, base_a, other, NeighborDrop{}, subwalks, listed, results, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }
 

@@ -141,16 +141,30 @@ struct ResultBuffers {
 /// three corners have clear fans (detect/fan.h). Such a pair shares a clear vertex, so its test
 /// would end at once (detect::cleared_by_fan): left out of the list, it is counted as a
 /// candidate and never screened. A triangle's later neighbours within 64 leaf positions are
-/// known per tree build (`later`, launch_later_neighbors: 80% of a settled 36K cloth's); the
-/// walk kernel keeps, per frame, those of the leaves whose corners are all clear in
-/// `frame_mask`, which the subwalks read. Null `later`: nothing is left out (no fans, the
+/// known per tree build (`later`, launch_later_neighbors: 80% of a settled 36K cloth's); each
+/// subwalk keeps them when its leaf's three corners are clear this frame (`fan_clear`, which
+/// the walk kernel before it fills: FanJob). Null `later`: nothing is left out (no fans, the
 /// filter deferred, or a frame with degenerate triangles, which are no candidates).
-/// Arrays indexed by the topology's triangle range of the part: base + leaf position.
+/// `later` is indexed by the topology's triangle range of the part: base + leaf position.
 struct NeighborDrop {
   const uint64_t* later = nullptr;
   const geom::Tri* triangles = nullptr;
   const uint8_t* fan_clear = nullptr;
-  uint64_t* frame_mask = nullptr;
+};
+
+/// The fans of a part checked against itself this frame: fan_clear[v] =
+/// detect::fan_is_clear(positions, planes, fans, v) for the vertices [first, first + count),
+/// after the planes of their triangles. Computed by blocks of their own in the part's walk
+/// kernel, beside the walks, which do not read them (the subwalks and the pair tests after it
+/// do): a launch of its own took ~8 us of a 36K frame's chain. count 0: none (no fans, or the
+/// filter deferred).
+struct FanJob {
+  const geom::Vec3d* positions = nullptr;
+  const geom::PlaneCoefficients* planes = nullptr;
+  detect::FanView fans;
+  int32_t first = 0;
+  int32_t count = 0;
+  uint8_t* fan_clear = nullptr;
 };
 
 /// Everything the pair tests of one frame read.
@@ -179,12 +193,6 @@ void launch_scan_degenerate(const geom::Vec3d* positions, const geom::Tri* trian
 /// Sets degenerate[list[i]] = 1 (an ordinary launch: it follows a copy).
 void launch_flag_degenerate(const int32_t* list, int32_t count, uint8_t* degenerate,
                             cudaStream_t stream);
-
-/// fan_clear[v] = detect::fan_is_clear(positions, planes, fans, v) for the vertices [first,
-/// first + n), after the planes of their triangles.
-void launch_fans(const geom::Vec3d* positions, const geom::PlaneCoefficients* planes,
-                 detect::FanView fans, int32_t first, int32_t n, uint8_t* fan_clear,
-                 cudaStream_t stream);
 
 /// For a tree just built over a part whose first triangle is `base`: later[base + p], per leaf
 /// position p, has bit d set when the leaf at p + 1 + d holds a triangle of the fan of a corner
@@ -218,10 +226,11 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// test kernel of its own: it computes no sides to screen with. The subwalks run one per
 /// thread; the screen on one wave of its blocks (at most `max_blocks`) striding over the list,
 /// and the whole test on a grid for the pairs expected (CandidateList::screened_expected, at
-/// most `max_blocks` blocks) striding over the pairs kept. `drop`: the fan-cleared neighbours
-/// the subwalks leave out (NeighborDrop).
+/// most `max_blocks` blocks) striding over the pairs kept. `fans`: the part's fans, computed
+/// beside the walks (FanJob); `drop`: the fan-cleared neighbours the subwalks leave out
+/// (NeighborDrop).
 void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs& inputs,
-                       const NeighborDrop& drop, const SubwalkList& subwalks,
+                       const FanJob& fans, const NeighborDrop& drop, const SubwalkList& subwalks,
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream);
 
