@@ -305,7 +305,7 @@ double time_check_command(const std::vector<seq::Frame>& frames, const std::stri
   settings.times = &loop;
   readers = readers_for(settings.threads, settings.gpu);
   const auto started = Clock::now();
-  report::ReportStream stream(out, SNAG_VERSION, {});
+  report::ReportStream stream(out, SNAG_VERSION, {}, {}, threads);
   report::Inputs inputs;
   check_sequence(
       frames, *checker, settings, inputs,

@@ -285,8 +285,10 @@ int run_check(const CheckOptions& o) {
   // stream, which removes its temporaries.
   std::optional<std::filesystem::path> report_dir;
   if (!o.out_dir.empty()) report_dir = o.out_dir;
+  // Frames are formatted side by side when they come faster than one thread formats them (a
+  // GPU's checks of many pairs); the formatters idle otherwise.
   report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings),
-                               inputs.objects);
+                               inputs.objects, threads);
 
   Progress progress(static_cast<int64_t>(resolved.frames.size()), o.quiet);
   SequenceSettings sequence;

@@ -372,8 +372,10 @@ std::vector<FrameRecord> random_frames(uint32_t seed, int count) {
 }
 
 TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
+  // One formatter, and as many as frames may wait (formatted side by side, written in order).
+  for (int formatters : {1, static_cast<int>(ReportStream::write_ahead)})
   for (uint32_t seed : {1u, 2u, 3u}) {
-    SCOPED_TRACE("seed=" + std::to_string(seed));
+    SCOPED_TRACE("seed=" + std::to_string(seed) + " formatters=" + std::to_string(formatters));
     Settings settings = small_settings();
     settings.weld = 1e-5;
     settings.frames.reset();
@@ -384,7 +386,7 @@ TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
     const std::vector<FrameRecord> frames = random_frames(seed, 60);
 
     TempDir tmp;
-    ReportStream stream(tmp.path(), "0.1.0", settings);
+    ReportStream stream(tmp.path(), "0.1.0", settings, {}, formatters);
     for (const FrameRecord& f : frames) stream.add(f);
     const Summary streamed = stream.finish(inputs, 3, 2, 12.25);
 
@@ -459,8 +461,9 @@ TEST(ReportStream, SceneRunMatchesTheWholeReportWriters) {
     inputs.objects = scene_objects();
     const std::vector<FrameRecord> frames = random_scene_frames(seed, 40, inputs.objects);
 
-    TempDir tmp;
-    ReportStream stream(tmp.path(), "0.1.0", settings, inputs.objects);
+    TempDir tmp;  // frames formatted side by side
+    ReportStream stream(tmp.path(), "0.1.0", settings, inputs.objects,
+                        static_cast<int>(ReportStream::write_ahead));
     for (const FrameRecord& f : frames) stream.add(f);
     const Summary streamed = stream.finish(inputs, 5, 1, 3.75);
 
@@ -619,20 +622,28 @@ TEST(ReportStream, FullDiskIsAWriteErrorAndLeavesNoFile) {
   // One frame of 20,000 pairs: about 0.5 MB of pairs.csv rows, and more of JSON.
   FrameRecord big = small_frames()[1];
   for (int32_t a = 0; a < 20000; ++a) big.pairs.push_back({a, a + 1, PairKind::touching, a, a});
-  const auto run = [&] {
-    FileSizeLimit limit(64 * 1024);
-    ReportStream stream(tmp.path(), "1.2.3", small_settings());
-    stream.add(big);
-    stream.finish(small_inputs(), 1, 0, 1.0);
-  };
-  try {
-    run();
-    ADD_FAILURE() << "no WriteError past the file size limit";
-  } catch (const WriteError& e) {
-    EXPECT_NE(std::string(e.what()).find("write failed"), std::string::npos) << e.what();
-    EXPECT_EQ(e.path().parent_path(), tmp.path());
+  // With one formatter, and with several formatting later frames while the first one's write
+  // fails (the error comes from a later add() or from finish()).
+  for (const int formatters : {1, static_cast<int>(ReportStream::write_ahead)}) {
+    SCOPED_TRACE("formatters=" + std::to_string(formatters));
+    const auto run = [&] {
+      FileSizeLimit limit(64 * 1024);
+      ReportStream stream(tmp.path(), "1.2.3", small_settings(), {}, formatters);
+      for (int k = 0; k < (formatters == 1 ? 1 : 6); ++k) {
+        big.frame = 10 + k;
+        stream.add(big);
+      }
+      stream.finish(small_inputs(), 1, 0, 1.0);
+    };
+    try {
+      run();
+      ADD_FAILURE() << "no WriteError past the file size limit";
+    } catch (const WriteError& e) {
+      EXPECT_NE(std::string(e.what()).find("write failed"), std::string::npos) << e.what();
+      EXPECT_EQ(e.path().parent_path(), tmp.path());
+    }
+    expect_earlier_run(tmp.path());
   }
-  expect_earlier_run(tmp.path());
 }
 
 TEST(ReportStream, UnusableDirectoryFailsAtOnce) {

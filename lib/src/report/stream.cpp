@@ -56,7 +56,7 @@ struct ReportStream::Files {
 };
 
 ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings,
-                           std::vector<ObjectInput> objects)
+                           std::vector<ObjectInput> objects, int formatters)
     : objects_(std::move(objects)), accumulator_(settings.fail_on) {
   run_.snag_version = std::move(snag_version);
   run_.settings = std::move(settings);
@@ -65,7 +65,8 @@ ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version
   files_->pairs_csv.out() << pairs_csv_header_for(objects_) << '\n';
   files_->frames_csv.out() << frames_csv_header_for(objects_) << '\n';
   write_report_json_head(files_->report_json.out(), run_);
-  writer_ = std::thread([this] { write_loop(); });
+  const int threads = std::clamp(formatters, 1, static_cast<int>(write_ahead));
+  for (int i = 0; i < threads; ++i) formatters_.emplace_back([this] { format_loop(); });
 }
 
 // files_'s StagedFiles then removes what was not renamed.
@@ -73,56 +74,90 @@ ReportStream::~ReportStream() {
   stop_writer();
 }
 
-void ReportStream::write_loop() {
-  bool first = true;
+void ReportStream::format_loop() {
+  std::unique_lock lock(mutex_);
   for (;;) {
-    std::unique_lock lock(mutex_);
-    handed_over_.wait(lock, [&] { return closing_ || !unwritten_.empty(); });
-    if (unwritten_.empty()) return;  // closing, all written
-    // The frame stays in the queue while it is written: add() counts it as unwritten.
-    const FrameRecord& frame = unwritten_.front();
+    handed_over_.wait(lock, [&] { return closing_ || taken_ < handed_; });
+    if (taken_ == handed_) return;  // closing, every frame taken
+    // References into the deque stay valid while others are added or written: this frame
+    // is neither written nor moved before it is marked formatted.
+    Unwritten& entry = unwritten_[taken_ - unwritten_.front().sequence];
+    ++taken_;
+    for (std::string* text : {&entry.pairs_text, &entry.json_text}) {
+      if (spare_texts_.empty()) break;
+      *text = std::move(spare_texts_.back());
+      spare_texts_.pop_back();
+    }
+    // After a failure the rest is dropped: the run is lost anyway.
+    const bool failed = write_error_ != nullptr;
     lock.unlock();
     std::exception_ptr error;
-    if (!write_error_) {  // after a failure the rest is dropped: the run is lost anyway
+    if (!failed) {
       try {
-        write_frame(frame, first);
+        append_pairs_rows(entry.pairs_text, entry.frame, objects_);
+        append_json_frame_element(entry.json_text, entry.frame, entry.sequence == 0, objects_);
       } catch (...) {
         error = std::current_exception();
       }
     }
-    first = false;
     lock.lock();
-    if (error) write_error_ = error;
-    unwritten_.pop_front();
-    lock.unlock();
-    written_.notify_all();
+    if (error && !write_error_) write_error_ = error;
+    entry.formatted = true;
+    write_ready(lock);
   }
 }
 
-void ReportStream::write_frame(const FrameRecord& frame, bool first) {
-  const auto write = [&](StagedFile& file) {
-    file.out().write(text_.data(), static_cast<std::streamsize>(text_.size()));
-    text_.clear();  // its capacity stays for the next frame
+void ReportStream::write_ready(std::unique_lock<std::mutex>& lock) {
+  if (writing_) return;
+  writing_ = true;
+  while (!unwritten_.empty() && unwritten_.front().formatted) {
+    // The frame stays in the queue while it is written: add() counts it as unwritten.
+    Unwritten& entry = unwritten_.front();
+    const bool failed = write_error_ != nullptr;
+    lock.unlock();
+    std::exception_ptr error;
+    if (!failed) {
+      try {
+        write_frame(entry);
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+    lock.lock();
+    if (error && !write_error_) write_error_ = error;
+    for (std::string* text : {&entry.pairs_text, &entry.json_text}) {
+      text->clear();  // its capacity stays for a later frame
+      spare_texts_.push_back(std::move(*text));
+    }
+    unwritten_.pop_front();
+    written_.notify_all();
+  }
+  writing_ = false;
+}
+
+void ReportStream::write_frame(Unwritten& entry) {
+  const auto write = [&](StagedFile& file, const std::string& text) {
+    file.out().write(text.data(), static_cast<std::streamsize>(text.size()));
   };
-  append_pairs_rows(text_, frame, objects_);
-  write(files_->pairs_csv);
-  write_frames_row(files_->frames_csv.out(), frame, objects_);
-  files_->file_names.out() << json_file_element(frame.file, first);
-  append_json_frame_element(text_, frame, first, objects_);
-  write(files_->report_json);
+  write(files_->pairs_csv, entry.pairs_text);
+  write_frames_row(files_->frames_csv.out(), entry.frame, objects_);
+  files_->file_names.out() << json_file_element(entry.frame.file, entry.sequence == 0);
+  write(files_->report_json, entry.json_text);
   for (const StagedFile* f :
        {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->report_json})
     f->check();
 }
 
 std::exception_ptr ReportStream::stop_writer() {
-  if (!writer_.joinable()) return write_error_;
+  if (formatters_.empty()) return write_error_;
   {
     std::lock_guard lock(mutex_);
     closing_ = true;
   }
   handed_over_.notify_all();
-  writer_.join();
+  // The last formatter to mark its frame formatted writes every frame left (write_ready).
+  for (std::thread& formatter : formatters_) formatter.join();
+  formatters_.clear();
   return write_error_;
 }
 
@@ -145,7 +180,7 @@ void ReportStream::add(FrameRecord frame) {
     std::unique_lock lock(mutex_);
     written_.wait(lock, [&] { return unwritten_.size() < write_ahead || write_error_; });
     if (write_error_) std::rethrow_exception(write_error_);
-    unwritten_.push_back(std::move(frame));
+    unwritten_.push_back({std::move(frame), handed_++, false, {}, {}});
   }
   handed_over_.notify_one();
 }

@@ -13,6 +13,11 @@
 //
 // The bytes are those of write_pairs_csv, write_frames_csv and report_json for the same frames
 // (one formatter per row and record serves both: csv.h, json.cpp).
+//
+// A frame's rows and record are formatted by one of the stream's threads (up to write_ahead of
+// them, each formatting a frame of its own), and written in the order the frames were added by
+// whichever of them finds the next frame formatted. One thread keeps up with a CPU check; a
+// GPU checks a 3K-pair frame in about half the time its ~560 KB of text take to format.
 #pragma once
 
 #include <condition_variable>
@@ -42,8 +47,11 @@ class ReportStream {
   /// front because they choose the CSV headers, written here, and name the objects in every
   /// row and frame record; only their names are used before finish(), whose inputs.objects
   /// (with the first frame's counts, say) must name the same objects in the same order.
+  ///
+  /// `formatters`: threads that format frames side by side (1 to write_ahead; clamped). They
+  /// take CPU time only while frames wait to be formatted.
   ReportStream(std::optional<std::filesystem::path> dir, std::string snag_version,
-               Settings settings, std::vector<ObjectInput> objects = {});
+               Settings settings, std::vector<ObjectInput> objects = {}, int formatters = 1);
   /// Without a successful finish() (an exception unwinding the run, say), removes every
   /// temporary: no report file appears, and an earlier run's files stay as they were.
   ~ReportStream();
@@ -57,7 +65,7 @@ class ReportStream {
   /// record must be one of the constructor's objects and frame.objects has one entry per
   /// object, else the write fails with InternalError (from a later add() or finish()).
   ///
-  /// The rows are formatted and written by the stream's own thread, so that a frame with
+  /// The rows are formatted and written by the stream's own threads, so that a frame with
   /// millions of pairs does not hold up the check of the next: add() hands the record over
   /// and returns, waiting only while write_ahead frames are still unwritten. A failed write
   /// throws WriteError from the next add() or from finish().
@@ -81,10 +89,24 @@ class ReportStream {
  private:
   struct Files;  // the temporaries, absent without an output directory
 
-  void write_loop();
-  void write_frame(const FrameRecord& frame, bool first);
-  /// Waits until every frame handed over is written, then stops the writer thread. Returns
-  /// its error, if a write failed.
+  /// A frame handed over: its record, then its pairs.csv rows and report.json element as its
+  /// formatter made them. `sequence` counts the frames handed over from 0.
+  struct Unwritten {
+    FrameRecord frame;
+    uint64_t sequence = 0;
+    bool formatted = false;
+    std::string pairs_text, json_text;
+  };
+
+  /// A formatter thread: takes the next frame not yet taken, formats it, then writes what is
+  /// ready (write_ready).
+  void format_loop();
+  /// With the lock held: writes the formatted frames at the front of the queue, in order,
+  /// unless another thread is writing (it will find them when its write is done).
+  void write_ready(std::unique_lock<std::mutex>& lock);
+  void write_frame(Unwritten& frame);
+  /// Waits until every frame handed over is written, then stops the formatter threads. Returns
+  /// their error, if a write failed.
   std::exception_ptr stop_writer();
 
   Report run_;                        ///< report.json's head and totals; its frames stay empty
@@ -92,18 +114,21 @@ class ReportStream {
   SummaryAccumulator accumulator_;
   std::optional<int64_t> last_frame_;
   std::unique_ptr<Files> files_;
-  /// The writer thread's text of a frame's rows, then of its record (~450 KB of report.json for
-  /// 3K pairs), each written at once; kept from frame to frame rather than allocated for each.
-  std::string text_;
   bool finished_ = false;
 
-  // The writer thread and the frames handed to it (only with an output directory).
+  // The formatter threads and the frames handed to them (only with an output directory). A
+  // frame's texts (~450 KB of report.json for 3K pairs) are each written at once; their buffers
+  // go back to `spare_texts_` rather than being allocated for every frame.
   std::mutex mutex_;
   std::condition_variable handed_over_, written_;
-  std::deque<FrameRecord> unwritten_;
+  std::deque<Unwritten> unwritten_;  ///< in sequence order; references stay valid at its ends
+  uint64_t handed_ = 0;              ///< frames handed over
+  uint64_t taken_ = 0;               ///< frames taken by a formatter (the next one's sequence)
+  bool writing_ = false;             ///< a thread is in write_ready's loop
+  std::vector<std::string> spare_texts_;
   bool closing_ = false;
   std::exception_ptr write_error_;
-  std::thread writer_;
+  std::vector<std::thread> formatters_;
 };
 
 }  // namespace snag::report
