@@ -207,6 +207,9 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   Upcoming current = take_next(prefetcher);
   lap(times.waiting);
   std::optional<ScenePrefetcher::Prefetched> previous;
+  // On the GPU, what moved between this frame and the next, found while this one was prepared:
+  // the next frame's `moved` (a comparison of every position, not made twice).
+  std::optional<std::vector<uint8_t>> moved_ahead;
   std::vector<report::Penetration> last_penetration;
   while (current.error || current.frame) {
     if (current.error) std::rethrow_exception(current.error);
@@ -332,11 +335,14 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
 
     // Which objects moved since the previous frame, and the next frame's since this one.
     std::vector<uint8_t> moved, next_moved;
-    if (previous && !topology_changed) moved = moved_between(previous->item, scene_frame);
+    if (previous && !topology_changed)
+      moved = moved_ahead ? std::move(*moved_ahead) : moved_between(previous->item, scene_frame);
+    moved_ahead.reset();
     std::span<const geom::Vec3d> next_positions;
     if (following.frame) {
       next_positions = following.frame->item.mesh.positions;
       next_moved = moved_between(scene_frame, following.frame->item);
+      moved_ahead = next_moved;  // `following` is the next iteration's frame, this one its previous
     }
     lap(times.preparing);
     // Read by snag's readers, which reject non-finite coordinates.
