@@ -66,7 +66,12 @@ ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version
   files_->frames_csv.out() << frames_csv_header_for(objects_) << '\n';
   write_report_json_head(files_->report_json.out(), run_);
   const int threads = std::clamp(formatters, 1, static_cast<int>(write_ahead));
-  for (int i = 0; i < threads; ++i) formatters_.emplace_back([this] { format_loop(); });
+  try {
+    for (int i = 0; i < threads; ++i) formatters_.emplace_back([this] { format_loop(); });
+  } catch (...) {
+    stop_writer();  // the threads started: a joinable thread left to its destructor terminates
+    throw;
+  }
 }
 
 // files_'s StagedFiles then removes what was not renamed.
