@@ -1,7 +1,6 @@
 // `snag bench accuracy` end to end on the hard-case corpus (no generated cloth, no data
 // folder): the table is written, the exact modes and CGAL score no error against the exact
 // answer, and the methods that guess are caught guessing, so the scoring is not vacuous.
-#include <cstdlib>
 #include <map>
 #include <string>
 
@@ -15,14 +14,10 @@ namespace {
 
 TEST(CliBench, AccuracyScoresTheHardCasesAgainstTheExactAnswer) {
   TempDir tmp;
-  const std::filesystem::path no_data = tmp.path() / "no-data";
-  std::filesystem::create_directories(no_data);
-  ::setenv("SNAG_DATA_DIR", no_data.c_str(), 1);  // the data cases are left out
-  const RunResult r = run_snag({"bench", "accuracy", "--sizes", "0", "--threads", "2", "--hard",
-                                (source_dir() / "samples/hard").string(), "-o",
-                                (tmp.path() / "acc").string()},
-                               tmp.path());
-  ::unsetenv("SNAG_DATA_DIR");
+  const RunResult r = run_snag_without_data(
+      {"bench", "accuracy", "--sizes", "0", "--threads", "2", "--hard",
+       (source_dir() / "samples/hard").string(), "-o", (tmp.path() / "acc").string()},
+      tmp.path());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_FALSE(read_text(tmp.path() / "acc/accuracy.md").empty());
   const auto rows = parse_csv(read_text(tmp.path() / "acc/accuracy.csv"));

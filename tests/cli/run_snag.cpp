@@ -7,9 +7,12 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 
 namespace snag::test {
 
@@ -52,6 +55,33 @@ RunResult run_snag(const std::vector<std::string>& args, const fs::path& cwd) {
   r.out = read_text(out_path);
   r.err = read_text(err_path);
   return r;
+}
+
+RunResult run_snag_without_data(const std::vector<std::string>& args, const fs::path& cwd) {
+  const fs::path no_data = cwd / "no-data";
+  fs::create_directories(no_data);
+  const char* was = std::getenv("SNAG_DATA_DIR");
+  const std::optional<std::string> previous = was ? std::optional<std::string>(was) : std::nullopt;
+  ::setenv("SNAG_DATA_DIR", no_data.c_str(), 1);
+  RunResult r = run_snag(args, cwd);
+  if (previous)
+    ::setenv("SNAG_DATA_DIR", previous->c_str(), 1);
+  else
+    ::unsetenv("SNAG_DATA_DIR");
+  return r;
+}
+
+std::vector<std::string> table_row(const std::string& text, const std::string& prefix, int nth) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(prefix, 0) != 0 || nth-- > 0) continue;
+    std::istringstream in(line.substr(prefix.size()));
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    return words;
+  }
+  ADD_FAILURE() << "no line starting '" << prefix << "' in:\n" << text;
+  return {};
 }
 
 TempDir::TempDir() {

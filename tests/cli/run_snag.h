@@ -19,6 +19,16 @@ struct RunResult {
 /// Runs snag with `args` in working directory `cwd`, standard input closed, and waits for it.
 RunResult run_snag(const std::vector<std::string>& args, const std::filesystem::path& cwd);
 
+/// run_snag with $SNAG_DATA_DIR an empty folder (cwd/no-data), so that a bench leaves out its
+/// shared-data cases; $SNAG_DATA_DIR is as it was afterwards.
+RunResult run_snag_without_data(const std::vector<std::string>& args,
+                                const std::filesystem::path& cwd);
+
+/// The whitespace-separated words after `prefix` of the `nth` line (from 0) of `text` that
+/// starts with it (a row of a bench table); a test failure and no words when there is none.
+std::vector<std::string> table_row(const std::string& text, const std::string& prefix,
+                                   int nth = 0);
+
 /// A fresh directory under the system temporary directory, removed with its contents.
 class TempDir {
  public:
