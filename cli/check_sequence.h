@@ -15,14 +15,16 @@
 
 namespace snag::cli {
 
-/// Where the frame loop's time went, in seconds summed over frames (on the loop's thread).
+/// Where the frame loop's time went, in seconds summed over frames: on the loop's thread (the
+/// checker's), and beside it on the preparing thread.
 struct LoopTimes {
-  double waiting = 0;    ///< for the readers: the frames were not read yet
-  double preparing = 0;  ///< topology and weld decisions, what moved (reading's share)
+  double waiting = 0;    ///< for the next frame, not yet read or compared
+  double preparing = 0;  ///< a topology's set-up (weld decisions, the checker's scene, meters)
   double checking = 0;   ///< Checker::check, exact decisions included
   double recording = 0;  ///< the frame's record: ids, groups, penetration
-  double handing = 0;    ///< on_frame (the report stream takes the record), the frame before
-                         ///< released
+  double handing = 0;    ///< on_frame (the report stream takes the record)
+  double comparing = 0;  ///< on the preparing thread: vertex counts, faces and what moved,
+                         ///< each frame against the one before (reading's share)
 };
 
 struct SequenceSettings {
@@ -55,6 +57,7 @@ int checker_threads_for(int threads, bool gpu);
 ///  - the topology comes from the first frame; later frames must have its vertex count, and a
 ///    different face list is a topology change (a new tree, record.topology_changed);
 ///  - with a weld, each topology's first frame decides which vertices count as one;
+///  - each frame is compared with the one before on a thread of its own, ahead of its check;
 ///  - on a GPU, each next frame is staged while the current one is checked.
 /// Each frame's record goes to `on_frame` as soon as it is checked; `warn` gets warnings (a
 /// first frame with coincident vertices and no weld). Fills inputs.ids, coincident_vertices

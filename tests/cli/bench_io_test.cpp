@@ -34,9 +34,10 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   ASSERT_EQ(cpu.size(), 8u);
   EXPECT_EQ(cpu[0], "1");           // readers: one per 16 threads, at least one
   EXPECT_GT(std::stod(cpu[3]), 0);  // snag check, seconds
-  // Where the loop's time went: five shares, none negative, adding up to no more than the loop.
+  // Where the loop's time went: five shares, none negative, adding up to no more than the loop;
+  // then the preparing thread's comparisons beside it.
   const std::vector<std::string> loop = table_row(r.out, "cpu ", 1);
-  ASSERT_EQ(loop.size(), 6u);
+  ASSERT_EQ(loop.size(), 7u);
   double shares = 0;
   for (size_t i = 0; i < 5; ++i) {
     EXPECT_GE(std::stod(loop[i]), 0) << i;
@@ -45,6 +46,7 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   EXPECT_GT(std::stod(loop[2]), 0);               // checking
   EXPECT_EQ(loop[5], cpu[3]);                     // the loop is snag check's time
   EXPECT_LE(shares, std::stod(loop[5]) + 0.005);  // three decimals each, rounded
+  EXPECT_GE(std::stod(loop[6]), 0);               // comparing (microseconds a frame here)
   for (const char* frames : {"       2 ", "       8 "})
     EXPECT_EQ(table_row(r.out, frames).size(), 3u) << frames;
 }
