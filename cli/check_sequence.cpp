@@ -10,6 +10,7 @@
 #include <mutex>
 #include <thread>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "snag/error.h"
@@ -82,11 +83,13 @@ class FrameHandoff {
     ready_.notify_one();
     return true;
   }
-  /// Preparing thread: no frame comes after those put.
-  void close() {
+  /// Preparing thread: no frame comes after those put; with `error`, the next frame's turn
+  /// throws it (kept aside: nothing to allocate while failing).
+  void close(std::exception_ptr error = nullptr) {
     {
       std::lock_guard lock(mutex_);
       closed_ = true;
+      error_ = std::move(error);
     }
     ready_.notify_one();
   }
@@ -112,7 +115,12 @@ class FrameHandoff {
 
  private:
   std::optional<PreparedFrame> pop(std::unique_lock<std::mutex>& lock) {
-    if (waiting_.empty()) return std::nullopt;
+    if (waiting_.empty()) {
+      if (!error_) return std::nullopt;
+      PreparedFrame failed;
+      failed.error = std::exchange(error_, nullptr);
+      return failed;
+    }
     PreparedFrame frame = std::move(waiting_.front());
     waiting_.pop_front();
     lock.unlock();
@@ -124,24 +132,25 @@ class FrameHandoff {
   std::mutex mutex_;
   std::condition_variable room_, ready_;
   std::deque<PreparedFrame> waiting_;
+  std::exception_ptr error_;  ///< the preparing thread's, after the frames waiting
   bool closed_ = false, stopped_ = false;
 };
 
 /// The preparing thread: takes each frame in order from the readers, checks its objects'
 /// vertex counts against the first frame's and compares its faces and positions with the frame
-/// before's, and puts it into `handoff`. A frame that failed (a bad file, a vertex count that
-/// changed) is put as its error, and nothing after it.
+/// before's, and puts it into `handoff`. A failure (a bad file, a vertex count that changed, or
+/// anything thrown here) closes the handoff with it, to be thrown at that frame's turn.
 void prepare_frames(ScenePrefetcher& prefetcher, const scene::ResolvedScene& scene,
                     bool scene_report, FrameHandoff& handoff) {
-  std::shared_ptr<const ScenePrefetcher::Prefetched> previous;
-  std::vector<int32_t> first_vertices;  // per object, the first frame's vertex count
-  std::vector<std::string> first_files;
-  for (;;) {
-    PreparedFrame prepared;
-    try {
+  try {
+    std::shared_ptr<const ScenePrefetcher::Prefetched> previous;
+    std::vector<int32_t> first_vertices;  // per object, the first frame's vertex count
+    std::vector<std::string> first_files;
+    for (;;) {
       std::optional<ScenePrefetcher::Prefetched> next = prefetcher.next();
       if (!next) break;
       const auto started = Clock::now();
+      PreparedFrame prepared;
       auto frame = std::make_shared<const ScenePrefetcher::Prefetched>(std::move(*next));
       const scene::SceneFrame& scene_frame = frame->item;
       const detect::PartLayout& layout = scene_frame.layout;
@@ -171,15 +180,12 @@ void prepare_frames(ScenePrefetcher& prefetcher, const scene::ResolvedScene& sce
       prepared.frame = frame;
       prepared.comparing_seconds = seconds_since(started);
       previous = std::move(frame);
-    } catch (...) {
-      prepared = {};
-      prepared.error = std::current_exception();
-      handoff.put(std::move(prepared));
-      break;
+      if (!handoff.put(std::move(prepared))) return;  // the checker's thread stopped
     }
-    if (!handoff.put(std::move(prepared))) break;
+    handoff.close();
+  } catch (...) {
+    handoff.close(std::current_exception());
   }
-  handoff.close();
 }
 
 /// The preparing thread of one run, joined on every way out of it, errors included: the
@@ -311,7 +317,9 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
 
   // Frames are read ahead on their own threads, each with its own FrameReaders (which parse
   // only positions while the faces stay those of their previous frame), while the current one
-  // is checked; at most readers + 2 frames are ahead whatever the sequence length.
+  // is checked: at most readers + 2 frames being read or waiting for the preparing thread,
+  // kPrepared waiting for this one, the preparing thread's previous and its current, and this
+  // thread's current and following, whatever the sequence length.
   const scene::SceneReader reader(scene);
   const int readers = readers_for(settings.threads, settings.gpu);
   const int workers = checker_threads_for(settings.threads, settings.gpu);
