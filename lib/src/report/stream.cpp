@@ -35,6 +35,25 @@ void append_scratch(const StagedFile& piece, std::ostream& out) {
                      "read failed on its temporary " + piece.temporary_path().filename().string());
 }
 
+/// With `lock` held: runs `work` with it released, unless a write failed already (the run is
+/// lost then, and the rest is dropped), and keeps the first error in `first_error`.
+template <class Work>
+void unlocked_unless_failed(std::unique_lock<std::mutex>& lock, std::exception_ptr& first_error,
+                            Work&& work) {
+  const bool failed = first_error != nullptr;
+  lock.unlock();
+  std::exception_ptr error;
+  if (!failed) {
+    try {
+      work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+  }
+  lock.lock();
+  if (error && !first_error) first_error = error;
+}
+
 }  // namespace
 
 /// The three reports' temporaries and report.json's spool of file names. The reports are created
@@ -93,20 +112,10 @@ void ReportStream::format_loop() {
       *text = std::move(spare_texts_.back());
       spare_texts_.pop_back();
     }
-    // After a failure the rest is dropped: the run is lost anyway.
-    const bool failed = write_error_ != nullptr;
-    lock.unlock();
-    std::exception_ptr error;
-    if (!failed) {
-      try {
-        append_pairs_rows(entry.pairs_text, entry.frame, objects_);
-        append_json_frame_element(entry.json_text, entry.frame, entry.sequence == 0, objects_);
-      } catch (...) {
-        error = std::current_exception();
-      }
-    }
-    lock.lock();
-    if (error && !write_error_) write_error_ = error;
+    unlocked_unless_failed(lock, write_error_, [&] {
+      append_pairs_rows(entry.pairs_text, entry.frame, objects_);
+      append_json_frame_element(entry.json_text, entry.frame, entry.sequence == 0, objects_);
+    });
     entry.formatted = true;
     write_ready(lock);
   }
@@ -118,18 +127,7 @@ void ReportStream::write_ready(std::unique_lock<std::mutex>& lock) {
   while (!unwritten_.empty() && unwritten_.front().formatted) {
     // The frame stays in the queue while it is written: add() counts it as unwritten.
     Unwritten& entry = unwritten_.front();
-    const bool failed = write_error_ != nullptr;
-    lock.unlock();
-    std::exception_ptr error;
-    if (!failed) {
-      try {
-        write_frame(entry);
-      } catch (...) {
-        error = std::current_exception();
-      }
-    }
-    lock.lock();
-    if (error && !write_error_) write_error_ = error;
+    unlocked_unless_failed(lock, write_error_, [&] { write_frame(entry); });
     for (std::string* text : {&entry.pairs_text, &entry.json_text}) {
       text->clear();  // its capacity stays for a later frame
       spare_texts_.push_back(std::move(*text));
