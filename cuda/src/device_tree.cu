@@ -3,6 +3,7 @@
 #include <thrust/iterator/transform_iterator.h>
 
 #include <algorithm>
+#include <cuda/atomic>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
@@ -109,16 +110,38 @@ __global__ void partition_kernel(CompleteTree shape, int32_t level, const int32_
   out[base + to] = t;
 }
 
-/// The box of the leaf at position p, from its triangle, whose plane the narrow phase reads
-/// (computed here, where the corners are loaded anyway, instead of in a launch of its own).
+/// A leaf's triangle and its corners, loaded: every load of a leaf's fit, issued before any
+/// of its stores, so that a thread fitting two leaves waits for both at once (a store to
+/// `planes` between them would order the second leaf's loads after it).
+struct LeafCorners {
+  int32_t triangle;
+  geom::Vec3d corner[3];
+};
+
+__device__ __forceinline__ LeafCorners load_leaf(const bvh::TreeView& tree,
+                                                 const mesh::MeshView& mesh, int32_t p) {
+  LeafCorners leaf;
+  leaf.triangle = tree.triangle_at[p];
+  const geom::Tri tri = mesh.triangles[leaf.triangle];
+  for (int k = 0; k < 3; ++k) leaf.corner[k] = mesh.positions[tri.v[k]];
+  return leaf;
+}
+
+/// The leaf's box and, into planes[], its triangle's plane, which the narrow phase reads
+/// (computed here, where the corners are loaded anyway, instead of in a launch of its own):
+/// bvh::leaf_box and detect::triangle_plane of the same corners.
+__device__ __forceinline__ geom::Box3f fit_leaf(const LeafCorners& leaf,
+                                                geom::PlaneCoefficients* planes) {
+  planes[leaf.triangle] =
+      geom::PlaneCoefficients::of(leaf.corner[0], leaf.corner[1], leaf.corner[2]);
+  return geom::triangle_box(leaf.corner[0], leaf.corner[1], leaf.corner[2]);
+}
+
 __device__ __forceinline__ geom::Box3f fit_leaf_and_plane(const bvh::TreeView& tree,
                                                           const mesh::MeshView& mesh,
                                                           geom::PlaneCoefficients* planes,
                                                           int32_t p) {
-  const int32_t t = tree.triangle_at[p];
-  const geom::Tri tri = mesh.triangles[t];
-  planes[t] = detect::triangle_plane(mesh.positions, tri);
-  return bvh::leaf_box(tri, mesh);
+  return fit_leaf(load_leaf(tree, mesh, p), planes);
 }
 
 __global__ void refit_leaves_kernel(bvh::TreeView tree, mesh::MeshView mesh,
@@ -133,34 +156,85 @@ __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t la
   if (node < last) bvh::refit_internal(node, tree);
 }
 
-/// The refit in one launch, a CUDA block per subtree of kRefitLevels levels: the block of the
-/// node at offset blockIdx.x of level top = depth - kRefitLevels (0 for small trees) fits its
-/// subtree's nodes level by level from the deepest up, each level's boxes kept in shared memory
-/// for the next, with a block barrier between levels. The last block to finish (a ticket, as
-/// the quality's) fits the levels above `top` from the blocks' roots the same way. Each box is
-/// geom::merge of the same two children or bvh::leaf_box, so the CPU's bits.
-/// It replaced a climb (one thread per leaf going up while it was the second child to arrive,
-/// an atomic and a fence per level: 16 dependent steps through L2 at 36K, 22.5 us) with about
-/// kRefitLevels block barriers and one ticket.
-constexpr int kRefitLevels = 9;
-constexpr int kRefitWidth = 1 << kRefitLevels;  // nodes of a subtree's deepest level
-constexpr int kRefitThreads = kRefitWidth;
+/// The refit in one launch. Each thread fits one node of level D - 1 (D the deepest level): a
+/// leaf from its triangle, or an internal node from its two children, leaves of level D that
+/// the thread fits first (the internal nodes of a level come before its leaves, so a warp's
+/// internal nodes are a prefix of its lanes). A block of kRefitThreads threads covers the
+/// subtree of kRefitLevels levels above level D - 1 under one node of level
+/// top = D - 1 - kRefitLevels (0 for small trees): each warp fits the five levels above its 32
+/// nodes in registers (a parent from its children's lanes by shuffles), the warps' roots meet in
+/// shared memory behind the block's one barrier, and the first warp fits the levels up to
+/// `top`. The last block to finish (a ticket, as the quality's) fits the levels above `top`
+/// from the blocks' roots. Each box is geom::merge of the same two children or the
+/// geom::triangle_box of its corners (bvh::leaf_box), so the CPU's bits.
+/// It replaced, in turn, a climb (one thread per leaf going up while it was the second child to
+/// arrive, an atomic and a fence per level: 16 dependent steps through L2 at 36K, 22.5 us) and
+/// blocks of 512 threads per subtree with a block barrier per level and boxes stored a float at
+/// a time by lanes 24 bytes apart. Without those barriers and scattered stores the kernel takes
+/// the same 12 us at 36K under ncu: what is left is a block's chain of dependent loads, the
+/// last block's tail and the launch (cuda/NOTES.md, v14).
+constexpr int kRefitLevels = 7;
+constexpr int kRefitThreads = 1 << kRefitLevels;  // nodes of level D - 1 under a block's root
+constexpr int kRefitWarps = kRefitThreads / 32;
+/// The last block's first warp takes the blocks' roots into registers, up to this many a lane;
+/// wider levels are merged through L2 by the whole block first.
+constexpr int kRootsPerLane = 8;
 
-/// Boxes of one level of a subtree being fit, and of the level above it: the level widths halve
-/// going up, so two buffers of kRefitWidth and kRefitWidth / 2 boxes take turns.
-struct RefitLevels {
-  geom::Box3f wide[kRefitWidth];
-  geom::Box3f narrow[kRefitWidth / 2];
+constexpr int kBoxWords = sizeof(geom::Box3f) / sizeof(float);
+static_assert(kBoxWords == 6, "a box is six floats, stored as words");
+
+/// A warp's boxes on their way out: each lane puts its box at its slot (stage_box), then the
+/// warp copies the slots to consecutive nodes as consecutive words (flush_boxes). A box stored
+/// a float at a time by lanes 24 bytes apart touched three times the sectors it filled.
+struct RefitStage {
+  float words[kRefitWarps][2 * 32 * kBoxWords];  // up to 64 boxes: the children of 32 nodes
+  geom::Box3f roots[kRefitWarps];
 };
 
-/// The box of `node` from its children's boxes at `children` (the level below's, indexed from
-/// that level's first node of this subtree) or, for a leaf, from its triangle.
-__device__ __forceinline__ geom::Box3f fit_node(const bvh::TreeView& tree,
-                                                const mesh::MeshView& mesh,
-                                                geom::PlaneCoefficients* planes, int32_t node,
-                                                const geom::Box3f* children, int32_t j) {
-  if (!tree.shape.is_leaf(node)) return geom::merge(children[2 * j], children[2 * j + 1]);
-  return fit_leaf_and_plane(tree, mesh, planes, tree.shape.position_of(node));
+__device__ __forceinline__ void stage_box(float* stage, int slot, const geom::Box3f& box) {
+  for (int k = 0; k < 3; ++k) {
+    stage[slot * kBoxWords + k] = box.lo[k];
+    stage[slot * kBoxWords + 3 + k] = box.hi[k];
+  }
+}
+
+/// Stores the boxes of slots 0 .. count - 1 to nodes first .. first + count - 1. Every lane of
+/// the warp calls it, after staging its boxes.
+__device__ __forceinline__ void flush_boxes(float* stage, geom::Box3f* boxes, int32_t first,
+                                            int count) {
+  __syncwarp();
+  float* const out = reinterpret_cast<float*>(boxes + first);
+  for (int w = static_cast<int>(threadIdx.x & 31); w < count * kBoxWords; w += 32)
+    out[w] = stage[w];
+  __syncwarp();  // every slot is read before the stage is written again
+}
+
+/// The box that lane `src` holds, for every lane of the warp.
+__device__ __forceinline__ geom::Box3f shuffle_box(const geom::Box3f& box, int src) {
+  geom::Box3f got;
+  for (int k = 0; k < 3; ++k) {
+    got.lo[k] = __shfl_sync(0xffffffffu, box.lo[k], src);
+    got.hi[k] = __shfl_sync(0xffffffffu, box.hi[k], src);
+  }
+  return got;
+}
+
+/// Lanes 0 .. count - 1 hold the boxes of the consecutive nodes from `first`, every node of
+/// one subtree's level (count a power of two, at most 32): fits and stores their ancestors up
+/// to that subtree's root, whose box lane 0 returns; `first` ends as the root. Every lane of
+/// the warp calls it.
+__device__ geom::Box3f fit_up_in_warp(float* stage, geom::Box3f* boxes, geom::Box3f box,
+                                      int count, int32_t& first) {
+  const int lane = static_cast<int>(threadIdx.x & 31);
+  for (; count > 1; count /= 2) {
+    const geom::Box3f left = shuffle_box(box, (2 * lane) & 31);
+    const geom::Box3f right = shuffle_box(box, (2 * lane + 1) & 31);
+    box = geom::merge(left, right);
+    first = (first - 1) / 2;
+    if (lane < count / 2) stage_box(stage, lane, box);
+    flush_boxes(stage, boxes, first, count / 2);
+  }
+  return box;
 }
 
 /// A box written by another SM in this launch: read from L2 (__ldcg), past a possibly stale
@@ -169,58 +243,17 @@ __device__ __forceinline__ geom::Box3f load_from_l2(const geom::Box3f* box) {
   geom::Box3f loaded;
   const float* src = reinterpret_cast<const float*>(box);
   float* dst = reinterpret_cast<float*>(&loaded);
-  for (int k = 0; k < 6; ++k) dst[k] = __ldcg(src + k);
+  for (int k = 0; k < kBoxWords; ++k) dst[k] = __ldcg(src + k);
   return loaded;
 }
 
-/// Fits levels `deepest` up to `root_level` (inclusive) of the subtree under node `offset` of
-/// `root_level`, one level at a time with a block barrier after each: every box goes to
-/// tree.boxes and to `here`, which serves as the next level's `below` (the two swap). `below`
-/// holds the boxes of the level under `deepest` when that level's nodes are internal. No level
-/// of the subtree is wider than the buffer it goes to (RefitLevels).
-__device__ void fit_subtree_levels(const bvh::TreeView& tree, const mesh::MeshView& mesh,
-                                   geom::PlaneCoefficients* planes, int32_t root_level,
-                                   int32_t offset, int32_t deepest, geom::Box3f* below,
-                                   geom::Box3f* here) {
-  const int32_t nodes = tree.shape.node_count();
-  for (int32_t level = deepest; level >= root_level; --level) {
-    const int32_t width = 1 << (level - root_level);
-    const int32_t first = CompleteTree::level_begin(level) + offset * width;
-    for (int32_t j = static_cast<int32_t>(threadIdx.x); j < width; j += kRefitThreads) {
-      const int32_t node = first + j;
-      if (node >= nodes) break;  // the deepest level ends early
-      const geom::Box3f box = fit_node(tree, mesh, planes, node, below, j);
-      tree.boxes[node] = box;
-      here[j] = box;
-    }
-    __syncthreads();
-    geom::Box3f* const filled = here;
-    here = below;
-    below = filled;
-  }
-}
-
-__global__ void __launch_bounds__(kRefitThreads)
-    refit_subtrees_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
-                          int32_t top, unsigned* ticket) {
-  __shared__ RefitLevels levels;
-  __shared__ bool last;
-  wait_for_previous_kernel();
-  // The block's subtree: its deepest level (all leaves) needs no `below`.
-  fit_subtree_levels(tree, mesh, planes, top, static_cast<int32_t>(blockIdx.x), tree.shape.depth,
-                     levels.narrow, levels.wide);
-  if (top == 0) return;
-
-  // The levels above: the last block, once every block's root is stored.
-  __threadfence();
-  if (threadIdx.x == 0) last = atomicAdd(ticket, 1u) == gridDim.x - 1;
-  __syncthreads();
-  if (!last) return;
-  if (threadIdx.x == 0) *ticket = 0;
-  // Levels wider than the buffers (above 2^18 triangles) through L2, then the rest in shared
-  // memory from the first level that fits.
+/// The last block's part: the levels above `top` from the 2^top blocks' roots in tree.boxes.
+/// Levels of more than 32 * kRootsPerLane nodes are merged by the whole block through L2, a
+/// barrier after each (past 2^16 triangles); then the first warp loads up to kRootsPerLane
+/// consecutive nodes a lane, halves them in registers to one, and fits the rest by shuffles.
+__device__ void fit_above_blocks(const bvh::TreeView& tree, float* stage, int32_t top) {
   int32_t level = top;
-  for (; (1 << level) > kRefitWidth; --level) {
+  for (; (1 << level) > 32 * kRootsPerLane; --level) {
     const int32_t first = CompleteTree::level_begin(level - 1);
     for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << (level - 1));
          j += kRefitThreads) {
@@ -230,10 +263,105 @@ __global__ void __launch_bounds__(kRefitThreads)
     }
     __syncthreads();
   }
-  for (int32_t j = static_cast<int32_t>(threadIdx.x); j < (1 << level); j += kRefitThreads)
-    levels.wide[j] = load_from_l2(tree.boxes + CompleteTree::level_begin(level) + j);
+  if (threadIdx.x >= 32) return;
+  const int lane = static_cast<int>(threadIdx.x);
+  const int lanes = min(1 << level, 32);
+  int run = (1 << level) / lanes;  // consecutive nodes a lane holds: 1 .. kRootsPerLane
+  int32_t first = CompleteTree::level_begin(level) + lane * run;
+  geom::Box3f held[kRootsPerLane] = {};
+#pragma unroll
+  for (int k = 0; k < kRootsPerLane; ++k)
+    if (k < run && lane < lanes) held[k] = load_from_l2(tree.boxes + first + k);
+  // A run's nodes are the children of the next half as many: merged and stored, down to one.
+  static_assert(kRootsPerLane == 8, "three halvings take a lane's run to one node");
+#pragma unroll
+  for (int halving = 0; halving < 3; ++halving) {
+    if (run == 1) break;
+    run /= 2;
+    first = (first - 1) / 2;
+#pragma unroll
+    for (int k = 0; k < kRootsPerLane / 2; ++k)
+      if (k < run) {
+        held[k] = geom::merge(held[2 * k], held[2 * k + 1]);
+        tree.boxes[first + k] = held[k];
+      }
+  }
+  first = __shfl_sync(0xffffffffu, first, 0);
+  fit_up_in_warp(stage, tree.boxes, held[0], lanes, first);
+}
+
+__global__ void __launch_bounds__(kRefitThreads)
+    refit_subtrees_kernel(bvh::TreeView tree, mesh::MeshView mesh, geom::PlaneCoefficients* planes,
+                          int32_t top, unsigned* ticket) {
+  __shared__ RefitStage stage;
+  __shared__ bool last;
+  wait_for_previous_kernel();
+  const int32_t depth = tree.shape.depth;
+  if (depth == 0) {  // one triangle: the root is its leaf
+    if (threadIdx.x == 0) tree.boxes[0] = fit_leaf_and_plane(tree, mesh, planes, 0);
+    return;
+  }
+  // The block's nodes of level D - 1: `width` of them, every one of that level when top is 0
+  // (a small tree, whose spare warps only join the barrier).
+  const int32_t width = 1 << (depth - 1 - top);
+  const int warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
+  const int lanes = min(width, 32), warps = max(width / 32, 1);
+  float* const warp_stage = stage.words[warp];
+  int32_t first = CompleteTree::level_begin(depth - 1) +
+                  static_cast<int32_t>(blockIdx.x) * width + warp * 32;
+  if (warp < warps) {
+    const int32_t node = first + lane;
+    const bool mine = lane < lanes;
+    const bool internal = mine && !tree.shape.is_leaf(node);
+    geom::Box3f box{}, left{}, right{};
+    if (internal) {
+      const LeafCorners a = load_leaf(tree, mesh, tree.shape.position_of(2 * node + 1));
+      const LeafCorners b = load_leaf(tree, mesh, tree.shape.position_of(2 * node + 2));
+      left = fit_leaf(a, planes);
+      right = fit_leaf(b, planes);
+      box = geom::merge(left, right);
+    } else if (mine) {
+      box = fit_leaf_and_plane(tree, mesh, planes, tree.shape.position_of(node));
+    }
+    // The children of the warp's internal nodes: consecutive nodes of level D, two a lane.
+    const int internal_lanes = __popc(__ballot_sync(0xffffffffu, internal));
+    if (internal_lanes > 0) {
+      if (internal) {
+        stage_box(warp_stage, 2 * lane, left);
+        stage_box(warp_stage, 2 * lane + 1, right);
+      }
+      flush_boxes(warp_stage, tree.boxes, 2 * first + 1, 2 * internal_lanes);
+    }
+    if (mine) stage_box(warp_stage, lane, box);
+    flush_boxes(warp_stage, tree.boxes, first, lanes);
+    box = fit_up_in_warp(warp_stage, tree.boxes, box, lanes, first);
+    if (lane == 0) stage.roots[warp] = box;
+  }
+  if (warps > 1) {
+    // The warps' roots: consecutive nodes of one level, fit up to the block's root.
+    __syncthreads();
+    if (warp == 0) {
+      first = CompleteTree::level_begin(CompleteTree::level_of(first)) +
+              static_cast<int32_t>(blockIdx.x) * warps;
+      const geom::Box3f root = lane < warps ? stage.roots[lane] : geom::Box3f{};
+      fit_up_in_warp(warp_stage, tree.boxes, root, warps, first);
+    }
+  }
+  if (top == 0) return;
+
+  // The levels above: the last block, once every block's root is stored. The root's words
+  // were stored by lanes of the first warp, ordered before its lane 0 by flush_boxes'
+  // __syncwarp; lane 0's ticket releases them (cumulatively) and, in the last block, acquires
+  // every other block's. An acquire-release atomic, not __threadfence (fence.sc) and a plain
+  // atomic: the same order at a lighter fence.
+  if (warp == 0 && lane == 0) {
+    ::cuda::atomic_ref<unsigned, ::cuda::thread_scope_device> blocks_done(*ticket);
+    last = blocks_done.fetch_add(1u, ::cuda::memory_order_acq_rel) == gridDim.x - 1;
+  }
   __syncthreads();
-  fit_subtree_levels(tree, mesh, planes, 0, 0, level - 1, levels.wide, levels.narrow);
+  if (!last) return;
+  if (threadIdx.x == 0) *ticket = 0;
+  fit_above_blocks(tree, stage.words[0], top);
 }
 
 /// The quality in one launch, one CUDA block per block of bvh::kQualityBlock internal nodes:
@@ -349,7 +477,7 @@ void DeviceTree::refit(mesh::MeshView mesh, geom::PlaneCoefficients* planes, cud
   if (n == 0) return;
   const bvh::TreeView tree = view();
   if (!level_by_level_refit) {
-    const int32_t top = std::max(0, shape_.depth - kRefitLevels);
+    const int32_t top = std::max(0, shape_.depth - 1 - kRefitLevels);
     launch_chained(refit_subtrees_kernel, dim3(1u << top), dim3(kRefitThreads), stream, tree, mesh,
                    planes, top, refit_ticket_.data());
     return;
