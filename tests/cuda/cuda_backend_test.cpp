@@ -133,12 +133,12 @@ TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
 
 TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
   SNAG_REQUIRE_GPU();
-  // Up to 128 leaves one block fits every level; then the last block's first warp takes the
-  // blocks' roots (2 to 256 of them: one a lane below 5,000 leaves, up to eight from 33,333),
-  // and past 2^16 leaves the whole block merges the widest levels above them first
-  // (cuda/src/device_tree.cu).
-  for (int32_t n : {1, 2, 3, 77, 128, 129, 257, 512, 513, 1000, 5000, 10000, 20000, 33333, 70000,
-                    300001}) {
+  // Up to 256 leaves one block fits every level (one warp up to 64, then two or four); then
+  // the last block's first warp takes the blocks' roots (2 to 256 of them: one a lane up to
+  // 8,192 leaves, two, four, then eight from 32,769), and past 2^16 leaves the whole block
+  // merges the widest levels above them first (cuda/src/device_tree.cu).
+  for (int32_t n : {1, 2, 3, 5, 20, 40, 77, 128, 129, 257, 512, 513, 1000, 1500, 3000, 5000, 10000,
+                    20000, 33333, 70000, 300001}) {
     SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
     const detect::Topology topology =
         detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
