@@ -79,6 +79,7 @@ Method snag_method(const std::string& backend, detect::ExactMode mode, int threa
   return {name, [=](const mesh::Mesh& first) {
             detect::CheckSettings settings;
             settings.exact = mode;
+            settings.threads = threads;
             std::shared_ptr<detect::Checker> checker =
                 validators::make_checker(make_backend(backend, threads, device), settings);
             checker->set_triangles(first.triangles, static_cast<int32_t>(first.positions.size()));

@@ -23,6 +23,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -249,6 +250,26 @@ struct SequenceRow {
   LoopTimes loop;  ///< where `snag check`'s loop spent `both`
 };
 
+/// f() on a thread of its own, its exception rethrown here. Checking alone and the check
+/// command each run this way: OpenMP keeps a pool of threads per thread that opens parallel
+/// regions, and a pool of `threads` workers left by checking alone would spin beside the check
+/// command's own, smaller one (its checker leaves cores to the readers and the report writer).
+template <class F>
+auto on_own_thread(F&& f) {
+  decltype(f()) result{};
+  std::exception_ptr error;
+  std::thread thread([&] {
+    try {
+      result = f();
+    } catch (...) {
+      error = std::current_exception();
+    }
+  });
+  thread.join();
+  if (error) std::rethrow_exception(error);
+  return result;
+}
+
 /// Seconds to read every frame with `readers` threads, as `snag check` reads them.
 double time_reading(const std::vector<seq::Frame>& frames, int readers) {
   const auto started = Clock::now();
@@ -264,7 +285,9 @@ double time_reading(const std::vector<seq::Frame>& frames, int readers) {
 
 std::unique_ptr<detect::Checker> make_sequence_checker(const std::string& backend, int threads,
                                                        int device) {
-  return validators::make_checker(make_backend(backend, threads, device), {});
+  detect::CheckSettings settings;
+  settings.threads = threads;
+  return validators::make_checker(make_backend(backend, threads, device), settings);
 }
 
 /// Seconds to check every frame from memory (read beforehand), each next frame staged.
@@ -326,10 +349,13 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
     std::cerr << "snag bench io: " << name << ": " << backend << "\n";
     SequenceRow row;
     row.backend = backend;
-    row.check = time_checking(frames, backend, threads, device, row.pairs);
+    row.check =
+        on_own_thread([&] { return time_checking(frames, backend, threads, device, row.pairs); });
     int64_t pipeline_pairs = 0;
-    row.both = time_check_command(frames, backend, threads, device, scratch / backend, row.readers,
-                                  pipeline_pairs, row.loop);
+    row.both = on_own_thread([&] {
+      return time_check_command(frames, backend, threads, device, scratch / backend, row.readers,
+                                pipeline_pairs, row.loop);
+    });
     if (pipeline_pairs != row.pairs)
       throw InternalError("bench io: snag check found " + std::to_string(pipeline_pairs) +
                           " pairs, checking from memory " + std::to_string(row.pairs));

@@ -257,7 +257,9 @@ std::vector<uint8_t> moved_between(const scene::SceneFrame& a, const scene::Scen
 
 std::unique_ptr<detect::Checker> make_scene_checker(const std::string& backend, int threads,
                                                     int device) {
-  return validators::make_checker(make_backend(backend, threads, device), {});
+  detect::CheckSettings settings;
+  settings.threads = threads;
+  return validators::make_checker(make_backend(backend, threads, device), settings);
 }
 
 /// The frame loop of `snag check` on `scene` (reading ahead, checking, penetration, records

@@ -256,9 +256,11 @@ int run_check(const CheckOptions& o) {
   // The run's threads are the checker's and its readers' (checker_threads_for).
   const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   const bool on_gpu = o.backend == "cuda" || (o.backend == "auto" && cuda_devices() > 0);
-  auto backend = make_backend(o.backend, checker_threads_for(threads, on_gpu), o.device);
+  const int checker_threads = checker_threads_for(threads, on_gpu);
+  auto backend = make_backend(o.backend, checker_threads, o.device);
   const std::string backend_name(backend->name());
   detect::CheckSettings settings;
+  settings.threads = checker_threads;
   settings.rebuild = rebuild_policy(o.rebuild);
   settings.rebuild_threshold = o.rebuild_threshold;
   settings.exact = *exact;

@@ -286,7 +286,8 @@ int readers_for(int threads, bool gpu) {
 
 int checker_threads_for(int threads, bool gpu) {
   threads = std::max(threads, 1);
-  return gpu || threads < 8 ? threads : threads - readers_for(threads, gpu);
+  if (gpu || threads < 8) return threads;
+  return threads - readers_for(threads, gpu) - threads / 16;
 }
 
 void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker,

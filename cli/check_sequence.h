@@ -48,9 +48,13 @@ int readers_for(int threads, bool gpu);
 /// were starved in turn. 16 cores of the H100 host, 200 frames of 36K triangles, snag check
 /// against checking alone on 16 threads: 2.05 times with 16 workers and a reader on top, 1.45
 /// with 12 workers and 4 readers, 1.26 with 14 and 2, 1.21 with 15 and 1 (whose loop checked
-/// as fast as the check alone). Below 8 threads, where a reader's core would be an eighth to a
-/// half of the check's, and on a GPU, where the host mostly waits, the readers come on top and
-/// the checker has all `threads`.
+/// as fast as the check alone). From 16 threads one more core in 16 is left to the preparing
+/// thread and the report stream's formatters, whose frames otherwise waited for a core while
+/// the workers spun: snag check 0.49-0.58 s with 15 workers, 0.41-0.52 with 14, four runs each
+/// (the same host, checking alone 0.27-0.43; with 14 the loop's wait to hand a frame to the
+/// report stream 0.001-0.06 s where it was 0.09-0.10). Below 8 threads, where a reader's core
+/// would be an eighth to a half of the check's, and on a GPU, where the host mostly waits, the
+/// readers come on top and the checker has all `threads`.
 int checker_threads_for(int threads, bool gpu);
 
 /// Reads `frames` ahead and checks them in order with `checker`:

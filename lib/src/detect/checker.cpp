@@ -130,7 +130,7 @@ FrameResult Checker::check(const FrameInput& input) {
     for (const PartCheck& c : topo.checks) result.checks.push_back({c.a, c.b, 0, false, 0.0});
     return result;
   }
-  const ExactContext context{positions, topology_.get()};
+  const ExactContext context{positions, topology_.get(), settings_.threads};
   backend_->set_part_positions(positions, moved);
   if (!input.next_positions.empty())
     backend_->stage_part_positions(input.next_positions, input.next_moved);

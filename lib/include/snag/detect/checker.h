@@ -25,6 +25,9 @@ struct CheckSettings {
   /// over the root's half area) exceeds this factor times its value right after the last build.
   double rebuild_threshold = 1.5;
   ExactMode exact = ExactMode::uncertain;
+  /// Threads of the exact stage's parallel loops (ExactContext::threads): snag check gives its
+  /// checker's, so that --threads caps them too. 0: OpenMP's default (every core).
+  int threads = 0;
 };
 
 /// One frame handed to Checker::check.

@@ -49,6 +49,8 @@ struct EdgeTriangleTask {
 struct ExactContext {
   std::span<const geom::Vec3d> positions;
   const Topology* topology = nullptr;
+  /// Threads of the exact stage's parallel loops (CheckSettings::threads); 0: OpenMP's default.
+  int threads = 0;
 };
 
 class ExactResolver {

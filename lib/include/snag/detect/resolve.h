@@ -3,6 +3,8 @@
 // decision procedures as the filter (snag/geom/narrow_phase.h), on the tests it left.
 #pragma once
 
+#include <omp.h>
+
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -15,6 +17,11 @@
 namespace snag::detect {
 
 namespace detail {
+/// The threads of an exact loop: `threads` (ExactContext::threads), else OpenMP's default.
+inline int exact_threads(int threads) {
+  return threads > 0 ? threads : omp_get_max_threads();
+}
+
 inline bool decided(geom::Answer answer, const char* what) {
   if (answer == geom::Answer::uncertain)
     throw InternalError(std::string("a predicate provider that is never uncertain left a test "
@@ -24,12 +31,14 @@ inline bool decided(geom::Answer answer, const char* what) {
 }
 }  // namespace detail
 
-/// hit[i] = 1 when tasks[i]'s edge meets its triangle beyond their shared endpoints.
+/// hit[i] = 1 when tasks[i]'s edge meets its triangle beyond their shared endpoints. Each of
+/// the three loops here runs on `threads` threads (detail::exact_threads).
 template <class P>
-void resolve_edge_hits(const P& pred, const Topology& topo,
-                       std::span<const EdgeTriangleTask> tasks, std::span<uint8_t> hit) {
+void resolve_edge_hits(const P& pred, const Topology& topo, std::span<const EdgeTriangleTask> tasks,
+                       std::span<uint8_t> hit, int threads) {
   const auto count = static_cast<int64_t>(tasks.size());
-#pragma omp parallel for schedule(dynamic, 16) if (count > 256)
+#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
+    schedule(dynamic, 16) if (count > 256)
   for (int64_t i = 0; i < count; ++i) {
     const auto [p, q] = topo.edges[tasks[i].edge];
     const geom::Tri& t = topo.triangles[tasks[i].triangle];
@@ -37,17 +46,18 @@ void resolve_edge_hits(const P& pred, const Topology& topo,
     const bool q_shared = q == t.v[0] || q == t.v[1] || q == t.v[2];
     const geom::Sign sp = p_shared ? geom::Sign::zero : pred.orient3d(t.v[0], t.v[1], t.v[2], p);
     const geom::Sign sq = q_shared ? geom::Sign::zero : pred.orient3d(t.v[0], t.v[1], t.v[2], q);
-    hit[i] = detail::decided(geom::edge_hits_triangle(pred, p, q, t, sp, sq),
-                             "edge against triangle");
+    hit[i] =
+        detail::decided(geom::edge_hits_triangle(pred, p, q, t, sp, sq), "edge against triangle");
   }
 }
 
 /// kinds[i] = the kind of the intersecting pair pairs[i].
 template <class P>
 void resolve_pair_kinds(const P& pred, const Topology& topo, std::span<const FacePair> pairs,
-                        std::span<PairKind> kinds) {
+                        std::span<PairKind> kinds, int threads) {
   const auto count = static_cast<int64_t>(pairs.size());
-#pragma omp parallel for schedule(dynamic, 16) if (count > 256)
+#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
+    schedule(dynamic, 16) if (count > 256)
   for (int64_t i = 0; i < count; ++i) {
     const bool crossing = detail::decided(
         geom::is_crossing(pred, topo.triangles[pairs[i].a], topo.triangles[pairs[i].b]),
@@ -59,9 +69,10 @@ void resolve_pair_kinds(const P& pred, const Topology& topo, std::span<const Fac
 /// degenerate[i] = 1 when triangles[i] has zero area (collinear corners).
 template <class P>
 void resolve_degenerate(const P& pred, const Topology& topo, std::span<const int32_t> triangles,
-                        std::span<uint8_t> degenerate) {
+                        std::span<uint8_t> degenerate, int threads) {
   const auto count = static_cast<int64_t>(triangles.size());
-#pragma omp parallel for schedule(static) if (count > 4096)
+#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
+    schedule(static) if (count > 4096)
   for (int64_t i = 0; i < count; ++i) {
     const geom::Tri& t = topo.triangles[triangles[i]];
     degenerate[i] = detail::decided(geom::is_degenerate(pred, t.v[0], t.v[1], t.v[2]), "zero area");
@@ -74,16 +85,18 @@ class ProviderResolver : public ExactResolver {
  public:
   void edge_hits(const ExactContext& context, std::span<const EdgeTriangleTask> tasks,
                  std::span<uint8_t> hit) override {
-    resolve_edge_hits(Provider{context.positions.data()}, *context.topology, tasks, hit);
+    resolve_edge_hits(Provider{context.positions.data()}, *context.topology, tasks, hit,
+                      context.threads);
   }
   void pair_kinds(const ExactContext& context, std::span<const FacePair> pairs,
                   std::span<PairKind> kinds) override {
-    resolve_pair_kinds(Provider{context.positions.data()}, *context.topology, pairs, kinds);
+    resolve_pair_kinds(Provider{context.positions.data()}, *context.topology, pairs, kinds,
+                       context.threads);
   }
   void degenerate(const ExactContext& context, std::span<const int32_t> triangles,
                   std::span<uint8_t> degenerate) override {
-    resolve_degenerate(Provider{context.positions.data()}, *context.topology, triangles,
-                       degenerate);
+    resolve_degenerate(Provider{context.positions.data()}, *context.topology, triangles, degenerate,
+                       context.threads);
   }
 };
 
