@@ -341,8 +341,7 @@ __global__ void __launch_bounds__(kRefitThreads)
     // The warps' roots: consecutive nodes of one level, fit up to the block's root.
     __syncthreads();
     if (warp == 0) {
-      first = CompleteTree::level_begin(CompleteTree::level_of(first)) +
-              static_cast<int32_t>(blockIdx.x) * warps;
+      // fit_up_in_warp left warp 0's `first` at its root, the first of the warps' roots.
       const geom::Box3f root = lane < warps ? stage.roots[lane] : geom::Box3f{};
       fit_up_in_warp(warp_stage, tree.boxes, root, warps, first);
     }
