@@ -48,18 +48,12 @@ std::vector<std::string> table(const std::string& text, const std::string& heade
   return rows;
 }
 
-/// The words after `prefix` of the row of `rows` that starts with it.
+/// The words after `prefix` of the row of `rows` that starts with it (table_row over the rows).
 std::vector<std::string> words_after(const std::vector<std::string>& rows,
                                      const std::string& prefix) {
-  for (const std::string& r : rows) {
-    if (r.rfind(prefix + " ", 0) != 0) continue;
-    std::istringstream in(r.substr(prefix.size()));
-    std::vector<std::string> words;
-    for (std::string w; in >> w;) words.push_back(w);
-    return words;
-  }
-  ADD_FAILURE() << "no row starting '" << prefix << "'";
-  return {};
+  std::string text;
+  for (const std::string& r : rows) text += r + "\n";
+  return table_row(text, prefix + " ");
 }
 
 size_t rows_starting(const std::vector<std::string>& rows, const std::string& prefix) {
