@@ -1,6 +1,6 @@
 #include "snag/validators/exact_modes.h"
 
-#include "snag/detect/resolve.h"
+#include "snag/threads.h"
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/cgal_resolver.h"
 
@@ -16,7 +16,7 @@ class CgalConfirmer final : public detect::PairConfirmer {
     const auto count = static_cast<int64_t>(pairs.size());
     // 0: confirmed, 1: not intersecting, 2: the other kind.
     std::vector<uint8_t> verdict(pairs.size(), 0);
-#pragma omp parallel for num_threads(detect::detail::exact_threads(context.threads)) \
+#pragma omp parallel for num_threads(thread_count(context.threads)) \
     schedule(dynamic, 64) if (count > 256)
     for (int64_t i = 0; i < count; ++i) {
       const geom::Tri& a = triangles[pairs[i].a];

@@ -11,6 +11,7 @@
 #include "snag/detect/pair_test.h"
 #include "snag/detect/pairs.h"
 #include "snag/geom/narrow_phase.h"
+#include "snag/threads.h"
 
 namespace snag::detect {
 
@@ -160,7 +161,7 @@ bool cpu_has_avx2() {
 class CpuBackend final : public Backend {
  public:
   CpuBackend(int threads, CpuWalkWidth width)
-      : threads_(threads > 0 ? threads : omp_get_max_threads()),
+      : threads_(thread_count(threads)),
         wide_(cpu_walk_lanes(width) == 8),
         avx2_(cpu_has_avx2()) {}
 

@@ -1,7 +1,5 @@
 #include "snag/measure/penetration.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,6 +7,7 @@
 
 #include "snag/error.h"
 #include "snag/mesh/mesh.h"
+#include "snag/threads.h"
 
 namespace snag::measure {
 
@@ -320,10 +319,6 @@ Reading read_point(geom::Vec3d p, const Surface& s) {
 }
 
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-
-int thread_count(int threads) {
-  return threads > 0 ? threads : omp_get_max_threads();
-}
 
 }  // namespace
 

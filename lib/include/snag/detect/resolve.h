@@ -3,8 +3,6 @@
 // decision procedures as the filter (snag/geom/narrow_phase.h), on the tests it left.
 #pragma once
 
-#include <omp.h>
-
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -13,15 +11,11 @@
 #include "snag/detect/exact.h"
 #include "snag/error.h"
 #include "snag/geom/narrow_phase.h"
+#include "snag/threads.h"
 
 namespace snag::detect {
 
 namespace detail {
-/// The threads of an exact loop: `threads` (ExactContext::threads), else OpenMP's default.
-inline int exact_threads(int threads) {
-  return threads > 0 ? threads : omp_get_max_threads();
-}
-
 inline bool decided(geom::Answer answer, const char* what) {
   if (answer == geom::Answer::uncertain)
     throw InternalError(std::string("a predicate provider that is never uncertain left a test "
@@ -32,13 +26,12 @@ inline bool decided(geom::Answer answer, const char* what) {
 }  // namespace detail
 
 /// hit[i] = 1 when tasks[i]'s edge meets its triangle beyond their shared endpoints. Each of
-/// the three loops here runs on `threads` threads (detail::exact_threads).
+/// the three loops here runs on thread_count(threads) threads (threads: ExactContext::threads).
 template <class P>
 void resolve_edge_hits(const P& pred, const Topology& topo, std::span<const EdgeTriangleTask> tasks,
                        std::span<uint8_t> hit, int threads) {
   const auto count = static_cast<int64_t>(tasks.size());
-#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
-    schedule(dynamic, 16) if (count > 256)
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 16) if (count > 256)
   for (int64_t i = 0; i < count; ++i) {
     const auto [p, q] = topo.edges[tasks[i].edge];
     const geom::Tri& t = topo.triangles[tasks[i].triangle];
@@ -56,8 +49,7 @@ template <class P>
 void resolve_pair_kinds(const P& pred, const Topology& topo, std::span<const FacePair> pairs,
                         std::span<PairKind> kinds, int threads) {
   const auto count = static_cast<int64_t>(pairs.size());
-#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
-    schedule(dynamic, 16) if (count > 256)
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 16) if (count > 256)
   for (int64_t i = 0; i < count; ++i) {
     const bool crossing = detail::decided(
         geom::is_crossing(pred, topo.triangles[pairs[i].a], topo.triangles[pairs[i].b]),
@@ -71,8 +63,7 @@ template <class P>
 void resolve_degenerate(const P& pred, const Topology& topo, std::span<const int32_t> triangles,
                         std::span<uint8_t> degenerate, int threads) {
   const auto count = static_cast<int64_t>(triangles.size());
-#pragma omp parallel for num_threads(detail::exact_threads(threads)) \
-    schedule(static) if (count > 4096)
+#pragma omp parallel for num_threads(thread_count(threads)) schedule(static) if (count > 4096)
   for (int64_t i = 0; i < count; ++i) {
     const geom::Tri& t = topo.triangles[triangles[i]];
     degenerate[i] = detail::decided(geom::is_degenerate(pred, t.v[0], t.v[1], t.v[2]), "zero area");
