@@ -42,7 +42,6 @@
 #include "snag/report/stream.h"
 #include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
-#include "snag/validators/exact_modes.h"
 
 namespace snag::cli {
 
@@ -283,20 +282,13 @@ double time_reading(const std::vector<seq::Frame>& frames, int readers) {
   return seconds_since(started);
 }
 
-std::unique_ptr<detect::Checker> make_sequence_checker(const std::string& backend, int threads,
-                                                       int device) {
-  detect::CheckSettings settings;
-  settings.threads = threads;
-  return validators::make_checker(make_backend(backend, threads, device), settings);
-}
-
 /// Seconds to check every frame from memory (read beforehand), each next frame staged.
 double time_checking(const std::vector<seq::Frame>& frames, const std::string& backend, int threads,
                      int device, int64_t& pairs) {
   std::vector<mesh::Mesh> meshes;
   io::FrameReader reader;
   for (const seq::Frame& f : frames) meshes.push_back(reader.read(f.path));
-  const std::unique_ptr<detect::Checker> checker = make_sequence_checker(backend, threads, device);
+  const std::unique_ptr<detect::Checker> checker = make_bench_checker(backend, threads, device);
   checker->set_triangles(meshes.front().triangles,
                          static_cast<int32_t>(meshes.front().positions.size()));
   checker->check(meshes.front().positions);  // warm-up: the first build, the buffers
@@ -316,7 +308,7 @@ double time_check_command(const std::vector<seq::Frame>& frames, const std::stri
                           int threads, int device, const fs::path& out, int& readers,
                           int64_t& pairs, LoopTimes& loop) {
   const std::unique_ptr<detect::Checker> checker =
-      make_sequence_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
+      make_bench_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   {  // warm-up, as for checking alone: the device and its buffers
     const mesh::Mesh first = io::read_mesh(frames.front().path);
     checker->set_triangles(first.triangles, static_cast<int32_t>(first.positions.size()));

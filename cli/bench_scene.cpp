@@ -19,7 +19,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -37,7 +36,6 @@
 #include "snag/scene/scene.h"
 #include "snag/scene/scene_frames.h"
 #include "snag/seq/sequence.h"
-#include "snag/validators/exact_modes.h"
 
 namespace snag::cli {
 
@@ -243,31 +241,12 @@ struct Row {
   std::vector<CheckRow> check_rows;
 };
 
-/// Per object: 0 when its positions in `b` are bit for bit those in `a` (as `snag check`
-/// compares them).
-std::vector<uint8_t> moved_between(const scene::SceneFrame& a, const scene::SceneFrame& b) {
-  const std::vector<int32_t>& begin = b.layout.vertex_begin;
-  std::vector<uint8_t> moved(begin.size() - 1, 1);
-  if (a.layout.vertex_begin != begin) return moved;
-  for (size_t p = 0; p + 1 < begin.size(); ++p)
-    moved[p] = std::memcmp(a.mesh.positions.data() + begin[p], b.mesh.positions.data() + begin[p],
-                           static_cast<size_t>(begin[p + 1] - begin[p]) * sizeof(geom::Vec3d)) != 0;
-  return moved;
-}
-
-std::unique_ptr<detect::Checker> make_scene_checker(const std::string& backend, int threads,
-                                                    int device) {
-  detect::CheckSettings settings;
-  settings.threads = threads;
-  return validators::make_checker(make_backend(backend, threads, device), settings);
-}
-
 /// The frame loop of `snag check` on `scene` (reading ahead, checking, penetration, records
 /// made and dropped): milliseconds between consecutive frames' records, and each frame's pairs.
 std::vector<double> time_frame_loop(const scene::ResolvedScene& scene, const std::string& backend,
                                     int threads, int device, std::vector<int64_t>& pairs) {
   const std::unique_ptr<detect::Checker> checker =
-      make_scene_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
+      make_bench_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   SequenceSettings settings;
   settings.threads = threads;
   settings.gpu = checker->backend_name() == "cuda";
@@ -321,7 +300,7 @@ Row run_scene(const SceneCase& c, const std::string& backend, const BenchSceneOp
 
   // Checked from memory: which objects moved (compared as `snag check` does) and
   // Checker::check, each next frame staged on a GPU.
-  const std::unique_ptr<detect::Checker> checker = make_scene_checker(backend, threads, o.device);
+  const std::unique_ptr<detect::Checker> checker = make_bench_checker(backend, threads, o.device);
   const bool gpu = checker->backend_name() == "cuda";
   auto set_scene = [&](detect::Checker& c) {
     const scene::SceneFrame& f = frames.front();
@@ -357,7 +336,7 @@ Row run_scene(const SceneCase& c, const std::string& backend, const BenchSceneOp
   for (size_t p = 0; p < build_ms.size(); ++p)
     build_ms[p].push_back(1e3 * outcomes.front().parts[p].build_seconds);
   for (int k = 1; k < kFirstFrameSamples; ++k) {
-    const std::unique_ptr<detect::Checker> fresh = make_scene_checker(backend, threads, o.device);
+    const std::unique_ptr<detect::Checker> fresh = make_bench_checker(backend, threads, o.device);
     set_ms.push_back(set_scene(*fresh));
     const auto started = Clock::now();
     const detect::FrameResult r = fresh->check(frames.front().mesh.positions);
@@ -435,7 +414,7 @@ void warm_up(const std::vector<SceneCase>& cases, const std::string& backend, in
     const scene::SceneReader reader(resolved);
     std::vector<io::FrameReader> readers = reader.make_readers();
     const scene::SceneFrame f = reader.read(0, readers);
-    const std::unique_ptr<detect::Checker> checker = make_scene_checker(backend, threads, device);
+    const std::unique_ptr<detect::Checker> checker = make_bench_checker(backend, threads, device);
     checker->set_scene(f.mesh.triangles, static_cast<int32_t>(f.mesh.positions.size()), f.layout,
                        resolved.checks);
     checker->check(f.mesh.positions);

@@ -12,9 +12,11 @@
 #include <iostream>
 #include <random>
 
+#include "backend_factory.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
+#include "snag/validators/exact_modes.h"
 
 extern char** environ;
 
@@ -27,6 +29,13 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::unique_ptr<detect::Checker> make_bench_checker(const std::string& backend, int threads,
+                                                    int device) {
+  detect::CheckSettings settings;
+  settings.threads = threads;
+  return validators::make_checker(make_backend(backend, threads, device), settings);
 }
 
 ScratchDir::ScratchDir() {

@@ -4,10 +4,12 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "snag/detect/checker.h"
 #include "snag/mesh/mesh.h"
 
 namespace snag::cli {
@@ -18,6 +20,11 @@ namespace snag::cli {
 inline constexpr int settle_frames = 24;
 
 double median(std::vector<double> v);
+
+/// The checker a bench times: default settings on `backend` (make_backend), its exact stage's
+/// loops on `threads` too, as snag check's are.
+std::unique_ptr<detect::Checker> make_bench_checker(const std::string& backend, int threads,
+                                                    int device);
 
 /// A temporary directory removed with everything in it when the bench ends.
 class ScratchDir {

@@ -39,19 +39,6 @@ bool same_faces(const std::vector<geom::Tri>& a, const std::vector<geom::Tri>& b
 
 using ScenePrefetcher = seq::Prefetcher<scene::SceneFrame>;
 
-/// Per object: 0 when its positions in `frame` are bit for bit those in `previous`.
-std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
-                                   const scene::SceneFrame& frame) {
-  const auto& begin = frame.layout.vertex_begin;
-  std::vector<uint8_t> moved(begin.size() - 1, 1);
-  if (previous.layout.vertex_begin != begin) return moved;
-  for (size_t p = 0; p + 1 < begin.size(); ++p)
-    moved[p] = std::memcmp(previous.mesh.positions.data() + begin[p],
-                           frame.mesh.positions.data() + begin[p],
-                           static_cast<size_t>(begin[p + 1] - begin[p]) * sizeof(geom::Vec3d)) != 0;
-  return moved;
-}
-
 /// A frame read ahead and compared with the frame before it on the preparing thread, waiting
 /// there for its turn on the checker's.
 struct PreparedFrame {
@@ -278,6 +265,18 @@ bool ignored(const scene::ResolvedScene& scene, int32_t object_a, const std::str
 }
 
 }  // namespace
+
+std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
+                                   const scene::SceneFrame& frame) {
+  const auto& begin = frame.layout.vertex_begin;
+  std::vector<uint8_t> moved(begin.size() - 1, 1);
+  if (previous.layout.vertex_begin != begin) return moved;
+  for (size_t p = 0; p + 1 < begin.size(); ++p)
+    moved[p] = std::memcmp(previous.mesh.positions.data() + begin[p],
+                           frame.mesh.positions.data() + begin[p],
+                           static_cast<size_t>(begin[p + 1] - begin[p]) * sizeof(geom::Vec3d)) != 0;
+  return moved;
+}
 
 int readers_for(int threads, bool gpu) {
   threads = std::max(threads, 1);

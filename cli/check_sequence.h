@@ -3,10 +3,12 @@
 // soon as its frame is checked.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "snag/detect/checker.h"
 #include "snag/report/report.h"
@@ -34,6 +36,11 @@ struct SequenceSettings {
   bool gpu = false;            ///< the checker runs on a GPU (see readers_for)
   LoopTimes* times = nullptr;  ///< when given, filled with where the loop's time went
 };
+
+/// Per object: 0 when its positions in `frame` are bit for bit those in `previous` (1 for every
+/// object when the two lay their objects out differently).
+std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
+                                   const scene::SceneFrame& frame);
 
 /// Reader threads for a run with `threads` workers. On the CPU a frame's reading costs about
 /// a fifteenth of its check on one thread (36K triangles: 1-2 ms against 15-30 ms), so one
