@@ -199,6 +199,98 @@ struct MeasuredCloth {
   measure::Clearance clearance;
 };
 
+/// A checked frame on its way to its record: the frame (its mesh, files and what moved), the
+/// checker's result, and its reading time.
+struct CheckedFrame {
+  PreparedFrame prepared;
+  detect::FrameResult result;
+  double read_seconds = 0;
+};
+
+/// Makes each checked frame's record and hands it on (`record`), in order. On a GPU it does so
+/// on a thread of its own, one frame behind the checks: the checks mostly wait for the device,
+/// and the record (pair ids, groups, penetration) and its hand-over to the report stream,
+/// ~75 us a frame at 36K triangles on the H100's host, then overlap the next frame's check
+/// instead of following it. At most one frame is recorded while the next is checked (add()
+/// waits for the one before). On the CPU the record is made in add() itself: there the check's
+/// workers have every core, and a penetration meter's OpenMP loops beside theirs would compete.
+///
+/// The recording thread reads what the loop's thread set up for the frame's topology (the
+/// checker's topology, the meters): the loop calls finish() before it changes them.
+class FrameRecorder {
+ public:
+  FrameRecorder(bool beside, std::function<void(CheckedFrame&&)> record)
+      : record_(std::move(record)) {
+    if (beside) thread_ = std::thread([this] { run(); });
+  }
+  ~FrameRecorder() {
+    if (!beside()) return;
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+  FrameRecorder(const FrameRecorder&) = delete;
+  FrameRecorder& operator=(const FrameRecorder&) = delete;
+
+  /// Records `frame` once the frame before is recorded; rethrows that frame's error.
+  void add(CheckedFrame&& frame) {
+    if (!beside()) {
+      record_(std::move(frame));
+      return;
+    }
+    std::unique_lock lock(wait_until_idle());
+    pending_ = std::move(frame);
+    lock.unlock();
+    changed_.notify_all();
+  }
+  /// Whether frames are recorded on a thread of their own.
+  bool beside() const { return thread_.joinable(); }
+  /// Waits until every frame added is recorded; rethrows a recording's error.
+  void finish() {
+    if (beside()) wait_until_idle();
+  }
+
+ private:
+  std::unique_lock<std::mutex> wait_until_idle() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return !pending_ && !busy_; });
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+    return lock;
+  }
+  void run() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      changed_.wait(lock, [&] { return stopping_ || pending_; });
+      if (stopping_) return;  // a frame not yet taken is dropped: the run failed
+      CheckedFrame frame = std::move(*pending_);
+      pending_.reset();
+      busy_ = true;
+      lock.unlock();
+      std::exception_ptr error;
+      try {
+        record_(std::move(frame));
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      busy_ = false;
+      if (error && !error_) error_ = std::move(error);
+      changed_.notify_all();
+    }
+  }
+
+  std::function<void(CheckedFrame&&)> record_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<CheckedFrame> pending_;
+  bool busy_ = false, stopping_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;  // last: started once the rest is made
+};
+
 /// A closed obstacle's meter, and the cloths it is measured against.
 struct Meter {
   int32_t obstacle = 0;
@@ -318,8 +410,9 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   // Frames are read ahead on their own threads, each with its own FrameReaders (which parse
   // only positions while the faces stay those of their previous frame), while the current one
   // is checked: at most readers + 2 frames being read or waiting for the preparing thread,
-  // kPrepared waiting for this one, the preparing thread's previous and its current, and this
-  // thread's current and following, whatever the sequence length.
+  // kPrepared waiting for this one, the preparing thread's previous and its current, this
+  // thread's current and following, and on a GPU the frame before being recorded, whatever the
+  // sequence length.
   const scene::SceneReader reader(scene);
   const int readers = readers_for(settings.threads, settings.gpu);
   const int workers = checker_threads_for(settings.threads, settings.gpu);
@@ -353,129 +446,16 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
     slot += std::chrono::duration<double>(now - mark).count();
     mark = now;
   };
-  std::optional<PreparedFrame> current = handoff.take();
-  lap(times.waiting);
+  // A checked frame's record, handed on (on a GPU beside this thread: FrameRecorder).
   std::vector<report::Penetration> last_penetration;
-  while (current) {
-    if (current->error) std::rethrow_exception(current->error);
-    // The frame after this one, when it is prepared already: a GPU copies its positions across
-    // while this one is checked. A frame that failed waits for its turn.
-    std::optional<PreparedFrame> following = handoff.take_if_ready();
-    lap(times.waiting);
-
-    const size_t i = current->frame->index;
+  const auto record_frame = [&](CheckedFrame&& checked) {
+    const auto started = Clock::now();
+    const size_t i = checked.prepared.frame->index;
     const seq::Frame& frame = scene.frames[i];
-    const auto read_started = Clock::now();  // welding counts as reading
-    const scene::SceneFrame& scene_frame = current->frame->item;
+    const scene::SceneFrame& scene_frame = checked.prepared.frame->item;
     const mesh::Mesh& mesh = scene_frame.mesh;
     const detect::PartLayout& layout = scene_frame.layout;
-    any_assimp = any_assimp || scene_frame.any_assimp;
-    const bool topology_changed = current->topology_changed;
-    if (i == 0 && scene_report)
-      for (int32_t o = 0; o < object_count; ++o) {
-        report::ObjectInput& input = inputs.objects.at(static_cast<size_t>(o));
-        input.vertices = layout.vertex_begin[o + 1] - layout.vertex_begin[o];
-        input.triangles = layout.triangle_begin[o + 1] - layout.triangle_begin[o];
-      }
-
-    if (i == 0 || topology_changed) {
-      // Welding is decided once per topology, on its first frame, per object with its own
-      // tolerance: seams stay closed while the cloth moves, and a weld that changed from
-      // frame to frame would rebuild the tree.
-      std::vector<int32_t> representative;
-      for (int32_t o = 0; o < object_count; ++o) {
-        const std::span<const geom::Vec3d> positions =
-            slice(mesh.positions, layout.vertex_begin, o);
-        const std::optional<double>& weld = scene.objects[o].spec.weld;
-        const std::string& file = scene_frame.files[o];
-        if (weld) {
-          const std::vector<int32_t> local = mesh::weld_representatives(positions, *weld);
-          int64_t welded = 0;
-          for (size_t v = 0; v < local.size(); ++v) {
-            welded += local[v] != static_cast<int32_t>(v);
-            representative.push_back(local[v] + layout.vertex_begin[o]);
-          }
-          if (i == 0) inputs.welded_vertices += welded;
-        } else {
-          for (int32_t v = layout.vertex_begin[o]; v < layout.vertex_begin[o + 1]; ++v)
-            representative.push_back(v);
-          if (i > 0) continue;
-          const int64_t coincident = mesh::count_coincident_vertices(positions);
-          inputs.coincident_vertices += coincident;
-          if (coincident > 0)
-            warn(file + ": " + std::to_string(coincident) +
-                 (coincident == 1 ? " vertex coincides" : " vertices coincide") +
-                 " exactly with another vertex but are separate vertices; unwelded seams are "
-                 "reported as intersections (use --weld TOL)");
-        }
-      }
-      bool any_weld = false;
-      for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
-        any_weld = any_weld || representative[v] != v;
-      if (!any_weld) representative.clear();
-      const std::vector<geom::Tri> welded = mesh::welded_triangles(mesh.triangles, representative);
-      checker.set_scene(welded, static_cast<int32_t>(mesh.positions.size()), layout, scene.checks);
-
-      // Penetration into each closed obstacle a cloth is checked against.
-      meters.clear();
-      for (const detect::PartCheck& c : scene.checks) {
-        if (c.self()) continue;
-        const auto role = [&](int32_t o) { return scene.objects[o].spec.role; };
-        if (role(c.a) == role(c.b)) continue;
-        const int32_t obstacle = role(c.a) == scene::Role::obstacle ? c.a : c.b;
-        const int32_t cloth = obstacle == c.a ? c.b : c.a;
-        auto at = std::find_if(meters.begin(), meters.end(),
-                               [&](const Meter& m) { return m.obstacle == obstacle; });
-        if (at == meters.end()) {
-          // Closedness as the weld sees it: a body stored as a triangle soup can be welded.
-          const std::vector<geom::Tri> local = local_triangles(welded, layout, obstacle);
-          const int32_t vertices =
-              layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
-          const std::optional<std::string> why = why_obstacle_not_closed(
-              scene_frame, local, obstacle, scene.objects[obstacle].spec.group.has_value());
-          if (i == 0 && scene_report) {
-            report::ObjectInput& input = inputs.objects[static_cast<size_t>(obstacle)];
-            input.closed = why ? *why : "closed";
-          }
-          if (why) continue;
-          // A closed obstacle whose faces point inwards would measure its complement: its
-          // inside is the side of negative enclosed volume, so it is measured flipped.
-          const std::span<const geom::Vec3d> positions =
-              slice(mesh.positions, layout.vertex_begin, obstacle);
-          auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
-          meter->update_positions(positions, workers);
-          if (meter->enclosed_volume() < 0) {
-            std::vector<geom::Tri> flipped = local;
-            for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
-            meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
-            meter->update_positions(positions, workers);
-          }
-          meters.push_back({obstacle, std::move(meter), {}, true});
-          at = meters.end() - 1;
-        }
-        at->cloths.push_back({cloth, {}});
-      }
-    }
-    const double read_seconds =
-        current->frame->read_seconds + current->comparing_seconds + seconds_since(read_started);
-    times.comparing += current->comparing_seconds;
-
-    // What moved since the frame before (not asked for a topology's first frame), and the next
-    // frame's positions and what moved in them since this one.
-    std::span<const uint8_t> moved;
-    if (!topology_changed) moved = current->moved;
-    std::span<const geom::Vec3d> next_positions;
-    std::span<const uint8_t> next_moved;
-    if (following && following->frame) {
-      next_positions = following->frame->item.mesh.positions;
-      next_moved = following->moved;
-    }
-    lap(times.preparing);
-    // Read by snag's readers, which reject non-finite coordinates.
-    const detect::FrameResult result =
-        checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});
-    lap(times.checking);
-
+    const detect::FrameResult& result = checked.result;
     report::FrameRecord record;
     if (!scene_report) {
       record = report::make_frame_record(
@@ -548,15 +528,161 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       last_penetration = penetration;
       record.penetration = std::move(penetration);
     }
-    record.topology_changed = topology_changed;
-    record.read_seconds = read_seconds;
-    lap(times.recording);
+    record.topology_changed = checked.prepared.topology_changed;
+    record.read_seconds = checked.read_seconds;
+    const auto made = Clock::now();
+    times.recording += std::chrono::duration<double>(made - started).count();
     on_frame(std::move(record));
-    lap(times.handing);
+    times.handing += seconds_since(made);
+  };
+  FrameRecorder recorder(settings.gpu, record_frame);
+  // The loop's waits for records made beside it; where they are made in add(), their time is
+  // recording and handing, and nothing more is counted.
+  double not_counted = 0;
+  double& behind = recorder.beside() ? times.behind : not_counted;
+  std::optional<PreparedFrame> current = handoff.take();
+  lap(times.waiting);
+  // A frame's error (or the checker's) is thrown once the frames before it are handed on.
+  try {
+    while (current) {
+      if (current->error) std::rethrow_exception(current->error);
+      // The frame after this one, when it is prepared already: a GPU copies its positions across
+      // while this one is checked. A frame that failed waits for its turn.
+      std::optional<PreparedFrame> following = handoff.take_if_ready();
+      lap(times.waiting);
 
-    current = following ? std::move(following) : handoff.take();
-    lap(times.waiting);
+      const size_t i = current->frame->index;
+      const auto read_started = Clock::now();  // welding counts as reading
+      const scene::SceneFrame& scene_frame = current->frame->item;
+      const mesh::Mesh& mesh = scene_frame.mesh;
+      const detect::PartLayout& layout = scene_frame.layout;
+      any_assimp = any_assimp || scene_frame.any_assimp;
+      const bool topology_changed = current->topology_changed;
+      if (i == 0 && scene_report)
+        for (int32_t o = 0; o < object_count; ++o) {
+          report::ObjectInput& input = inputs.objects.at(static_cast<size_t>(o));
+          input.vertices = layout.vertex_begin[o + 1] - layout.vertex_begin[o];
+          input.triangles = layout.triangle_begin[o + 1] - layout.triangle_begin[o];
+        }
+
+      if (i == 0 || topology_changed) {
+        // The frames before are recorded with the topology and meters they were checked with.
+        recorder.finish();
+        // Welding is decided once per topology, on its first frame, per object with its own
+        // tolerance: seams stay closed while the cloth moves, and a weld that changed from
+        // frame to frame would rebuild the tree.
+        std::vector<int32_t> representative;
+        for (int32_t o = 0; o < object_count; ++o) {
+          const std::span<const geom::Vec3d> positions =
+              slice(mesh.positions, layout.vertex_begin, o);
+          const std::optional<double>& weld = scene.objects[o].spec.weld;
+          const std::string& file = scene_frame.files[o];
+          if (weld) {
+            const std::vector<int32_t> local = mesh::weld_representatives(positions, *weld);
+            int64_t welded = 0;
+            for (size_t v = 0; v < local.size(); ++v) {
+              welded += local[v] != static_cast<int32_t>(v);
+              representative.push_back(local[v] + layout.vertex_begin[o]);
+            }
+            if (i == 0) inputs.welded_vertices += welded;
+          } else {
+            for (int32_t v = layout.vertex_begin[o]; v < layout.vertex_begin[o + 1]; ++v)
+              representative.push_back(v);
+            if (i > 0) continue;
+            const int64_t coincident = mesh::count_coincident_vertices(positions);
+            inputs.coincident_vertices += coincident;
+            if (coincident > 0)
+              warn(file + ": " + std::to_string(coincident) +
+                   (coincident == 1 ? " vertex coincides" : " vertices coincide") +
+                   " exactly with another vertex but are separate vertices; unwelded seams are "
+                   "reported as intersections (use --weld TOL)");
+          }
+        }
+        bool any_weld = false;
+        for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
+          any_weld = any_weld || representative[v] != v;
+        if (!any_weld) representative.clear();
+        const std::vector<geom::Tri> welded =
+            mesh::welded_triangles(mesh.triangles, representative);
+        checker.set_scene(welded, static_cast<int32_t>(mesh.positions.size()), layout,
+                          scene.checks);
+
+        // Penetration into each closed obstacle a cloth is checked against.
+        meters.clear();
+        for (const detect::PartCheck& c : scene.checks) {
+          if (c.self()) continue;
+          const auto role = [&](int32_t o) { return scene.objects[o].spec.role; };
+          if (role(c.a) == role(c.b)) continue;
+          const int32_t obstacle = role(c.a) == scene::Role::obstacle ? c.a : c.b;
+          const int32_t cloth = obstacle == c.a ? c.b : c.a;
+          auto at = std::find_if(meters.begin(), meters.end(),
+                                 [&](const Meter& m) { return m.obstacle == obstacle; });
+          if (at == meters.end()) {
+            // Closedness as the weld sees it: a body stored as a triangle soup can be welded.
+            const std::vector<geom::Tri> local = local_triangles(welded, layout, obstacle);
+            const int32_t vertices =
+                layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
+            const std::optional<std::string> why = why_obstacle_not_closed(
+                scene_frame, local, obstacle, scene.objects[obstacle].spec.group.has_value());
+            if (i == 0 && scene_report) {
+              report::ObjectInput& input = inputs.objects[static_cast<size_t>(obstacle)];
+              input.closed = why ? *why : "closed";
+            }
+            if (why) continue;
+            // A closed obstacle whose faces point inwards would measure its complement: its
+            // inside is the side of negative enclosed volume, so it is measured flipped.
+            const std::span<const geom::Vec3d> positions =
+                slice(mesh.positions, layout.vertex_begin, obstacle);
+            auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
+            meter->update_positions(positions, workers);
+            if (meter->enclosed_volume() < 0) {
+              std::vector<geom::Tri> flipped = local;
+              for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
+              meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
+              meter->update_positions(positions, workers);
+            }
+            meters.push_back({obstacle, std::move(meter), {}, true});
+            at = meters.end() - 1;
+          }
+          at->cloths.push_back({cloth, {}});
+        }
+      }
+      const double read_seconds =
+          current->frame->read_seconds + current->comparing_seconds + seconds_since(read_started);
+      times.comparing += current->comparing_seconds;
+
+      // What moved since the frame before (not asked for a topology's first frame), and the next
+      // frame's positions and what moved in them since this one.
+      std::span<const uint8_t> moved;
+      if (!topology_changed) moved = current->moved;
+      std::span<const geom::Vec3d> next_positions;
+      std::span<const uint8_t> next_moved;
+      if (following && following->frame) {
+        next_positions = following->frame->item.mesh.positions;
+        next_moved = following->moved;
+      }
+      lap(times.preparing);
+      // Read by snag's readers, which reject non-finite coordinates.
+      detect::FrameResult result =
+          checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});
+      lap(times.checking);
+      recorder.add({std::move(*current), std::move(result), read_seconds});
+      lap(behind);
+
+      current = following ? std::move(following) : handoff.take();
+      lap(times.waiting);
+    }
+    recorder.finish();
+  } catch (...) {
+    std::exception_ptr error = std::current_exception();
+    try {
+      recorder.finish();
+    } catch (...) {
+      error = std::current_exception();  // an earlier frame's: its failure came first
+    }
+    std::rethrow_exception(error);
   }
+  lap(behind);
   if (settings.times) *settings.times = times;
   inputs.ids = any_assimp ? "assimp" : "file";
 }

@@ -18,13 +18,15 @@
 namespace snag::cli {
 
 /// Where the frame loop's time went, in seconds summed over frames: on the loop's thread (the
-/// checker's), and beside it on the preparing thread.
+/// checker's), and beside it on the preparing thread and, on a GPU, the recording thread.
 struct LoopTimes {
   double waiting = 0;    ///< for the next frame, not yet read or compared
   double preparing = 0;  ///< a topology's set-up (weld decisions, the checker's scene, meters)
   double checking = 0;   ///< Checker::check, exact decisions included
-  double recording = 0;  ///< the frame's record: ids, groups, penetration
-  double handing = 0;    ///< on_frame (the report stream takes the record)
+  double recording = 0;  ///< the frame's record: ids, groups, penetration (on a GPU, beside
+                         ///< the loop on the recording thread, one frame behind the checks)
+  double handing = 0;    ///< on_frame (the report stream takes the record; where recording is)
+  double behind = 0;     ///< on a GPU, for the frame before's record and hand-over to be done
   double comparing = 0;  ///< on the preparing thread: vertex counts, faces and what moved,
                          ///< each frame against the one before (reading's share)
 };
@@ -70,10 +72,12 @@ int checker_threads_for(int threads, bool gpu);
 ///  - with a weld, each topology's first frame decides which vertices count as one;
 ///  - each frame is compared with the one before on a thread of its own, ahead of its check;
 ///  - on a GPU, each next frame is staged while the current one is checked.
-/// Each frame's record goes to `on_frame` as soon as it is checked; `warn` gets warnings (a
-/// first frame with coincident vertices and no weld). Fills inputs.ids, coincident_vertices
-/// and welded_vertices. Throws snag::InputError for a bad frame at its turn, after every frame
-/// before it was handed on.
+/// Each frame's record goes to `on_frame`, in order, as soon as it is checked: on a GPU from a
+/// recording thread while the next frame is checked, else from the calling thread (on_frame is
+/// never called from two threads at once, and `warn` never while on_frame runs); `warn` gets
+/// warnings (a first frame with coincident vertices and no weld). Fills inputs.ids,
+/// coincident_vertices and welded_vertices. Throws snag::InputError for a bad frame at its turn,
+/// after every frame before it was handed on.
 void check_sequence(std::span<const seq::Frame> frames, detect::Checker& checker,
                     const SequenceSettings& settings, report::Inputs& inputs,
                     const std::function<void(report::FrameRecord&&)>& on_frame,

@@ -1,0 +1,200 @@
+// The frame loop of `snag check` (cli/check_sequence.cpp) run in-process on the CPU backend,
+// both ways it hands records on: from the calling thread (the CPU's way) and from a recording
+// thread one frame behind the checks (a GPU's way, taken here with `gpu` set and a CPU
+// checker). The records are checked against each frame checked on its own, in order, and
+// errors against the frames handed on before them.
+#include "cli/check_sequence.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "snag/detect/cpu_backend.h"
+#include "snag/detect/resolve.h"
+#include "snag/error.h"
+#include "snag/io/read_mesh.h"
+#include "snag/scene/scene.h"
+#include "snag/seq/sequence.h"
+#include "test_paths.h"
+
+namespace snag::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::unique_ptr<detect::Checker> cpu_checker() {
+  return std::make_unique<detect::Checker>(detect::make_cpu_backend(2),
+                                           detect::make_rounded_resolver());
+}
+
+std::vector<seq::Frame> drape_frames() {
+  return seq::resolve_sequence((snag::test::source_dir() / "samples" / "drape").string());
+}
+
+/// What on_frame saw: the records in order, the threads it ran on, and whether two calls
+/// ever overlapped.
+struct Handed {
+  std::vector<report::FrameRecord> records;
+  std::vector<std::thread::id> threads;
+  std::atomic<int> inside{0};
+  bool overlapped = false;
+
+  void take(report::FrameRecord&& record) {
+    if (inside.fetch_add(1) != 0) overlapped = true;
+    threads.push_back(std::this_thread::get_id());
+    std::this_thread::sleep_for(std::chrono::microseconds(200));  // a slow report writer
+    records.push_back(std::move(record));
+    inside.fetch_sub(1);
+  }
+};
+
+SequenceSettings settings_for(bool beside) {
+  SequenceSettings settings;
+  settings.threads = 3;
+  settings.gpu = beside;  // a GPU's loop records beside the checks
+  return settings;
+}
+
+TEST(CheckSequence, RecordsAreEachFramesOwnCheckInOrderBothWays) {
+  const std::vector<seq::Frame> frames = drape_frames();
+  ASSERT_GE(frames.size(), 10u);
+  // The reference: every frame read and checked on its own.
+  std::vector<std::vector<detect::FacePair>> expected;
+  {
+    const std::unique_ptr<detect::Checker> checker = cpu_checker();
+    for (const seq::Frame& f : frames) {
+      const mesh::Mesh mesh = io::read_mesh(f.path);
+      if (expected.empty())
+        checker->set_triangles(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+      expected.push_back(checker->check(mesh.positions).pairs);
+    }
+  }
+  size_t frames_with_pairs = 0;
+  for (const auto& pairs : expected) frames_with_pairs += !pairs.empty();
+  ASSERT_GT(frames_with_pairs, 0u) << "the sample should fold through itself";
+
+  for (const bool beside : {false, true}) {
+    SCOPED_TRACE(beside ? "records beside the checks" : "records on the loop's thread");
+    const std::unique_ptr<detect::Checker> checker = cpu_checker();
+    report::Inputs inputs;
+    Handed handed;
+    LoopTimes times;
+    SequenceSettings settings = settings_for(beside);
+    settings.times = &times;
+    check_sequence(
+        frames, *checker, settings, inputs,
+        [&](report::FrameRecord&& r) { handed.take(std::move(r)); }, [](const std::string&) {});
+    ASSERT_EQ(handed.records.size(), frames.size());
+    EXPECT_FALSE(handed.overlapped);
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const report::FrameRecord& r = handed.records[i];
+      EXPECT_EQ(r.frame, frames[i].number);
+      ASSERT_EQ(r.pairs.size(), expected[i].size()) << "frame " << r.frame;
+      for (size_t k = 0; k < r.pairs.size(); ++k) {
+        EXPECT_EQ(r.pairs[k].a, expected[i][k].a);
+        EXPECT_EQ(r.pairs[k].b, expected[i][k].b);
+        EXPECT_EQ(r.pairs[k].kind, expected[i][k].kind);
+      }
+    }
+    for (const std::thread::id id : handed.threads)
+      EXPECT_EQ(id != std::this_thread::get_id(), beside);
+    EXPECT_GT(times.recording + times.handing, 0.0);
+    if (!beside) EXPECT_EQ(times.behind, 0.0);
+  }
+}
+
+/// `frames` copied into `dir`, the copy of frame `bad` (1-based position) given a face that
+/// names a vertex the file does not have.
+std::vector<seq::Frame> copies_with_a_bad_frame(const std::vector<seq::Frame>& frames,
+                                                const fs::path& dir, size_t bad) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const fs::path copy = dir / frames[i].path.filename();
+    fs::copy_file(frames[i].path, copy);
+    if (i + 1 == bad) std::ofstream(copy, std::ios::app) << "f 1 2 999999\n";
+  }
+  return seq::resolve_sequence(dir.string());
+}
+
+TEST(CheckSequence, ABadFrameIsThrownAfterEveryFrameBeforeItIsHandedOn) {
+  const fs::path dir = fs::temp_directory_path() / "snag_check_sequence_bad_frame";
+  const std::vector<seq::Frame> frames = copies_with_a_bad_frame(drape_frames(), dir, 5);
+  for (const bool beside : {false, true}) {
+    SCOPED_TRACE(beside ? "records beside the checks" : "records on the loop's thread");
+    const std::unique_ptr<detect::Checker> checker = cpu_checker();
+    report::Inputs inputs;
+    Handed handed;
+    try {
+      check_sequence(
+          frames, *checker, settings_for(beside), inputs,
+          [&](report::FrameRecord&& r) { handed.take(std::move(r)); }, [](const std::string&) {});
+      FAIL() << "the bad frame was not reported";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(frames[4].path.filename().string()), std::string::npos)
+          << e.what();
+    }
+    ASSERT_EQ(handed.records.size(), 4u);
+    for (size_t i = 0; i < 4; ++i) EXPECT_EQ(handed.records[i].frame, frames[i].number);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CheckSequence, AReportWritersErrorStopsTheRunAndIsThrown) {
+  const std::vector<seq::Frame> frames = drape_frames();
+  for (const bool beside : {false, true}) {
+    SCOPED_TRACE(beside ? "records beside the checks" : "records on the loop's thread");
+    const std::unique_ptr<detect::Checker> checker = cpu_checker();
+    report::Inputs inputs;
+    int handed = 0;
+    EXPECT_THROW(check_sequence(
+                     frames, *checker, settings_for(beside), inputs,
+                     [&](report::FrameRecord&&) {
+                       if (++handed == 3) throw std::runtime_error("disk full");
+                     },
+                     [](const std::string&) {}),
+                 std::runtime_error);
+    // The loop stops at the failed frame's turn: at most the frame checked meanwhile follows it.
+    EXPECT_EQ(handed, 3);
+  }
+}
+
+TEST(CheckSequence, AScenesPenetrationIsTheSameRecordedBesideTheChecks) {
+  const fs::path drape = snag::test::source_dir() / "samples" / "drape";
+  const scene::Scene scene = scene::scene_from_flags(
+      (drape / "drape.%04d.obj").string(),
+      {(snag::test::source_dir() / "samples" / "drape_sphere.obj").string()}, std::nullopt);
+  const scene::ResolvedScene resolved = scene::resolve_scene(scene, "");
+  std::vector<std::vector<report::FrameRecord>> runs;
+  for (const bool beside : {false, true}) {
+    const std::unique_ptr<detect::Checker> checker = cpu_checker();
+    report::Inputs inputs;
+    inputs.objects.resize(resolved.objects.size());
+    Handed handed;
+    check_scene(
+        resolved, *checker, settings_for(beside), /*scene_report=*/true, inputs,
+        [&](report::FrameRecord&& r) { handed.take(std::move(r)); }, [](const std::string&) {});
+    EXPECT_FALSE(handed.overlapped);
+    runs.push_back(std::move(handed.records));
+  }
+  ASSERT_EQ(runs[0].size(), resolved.frames.size());
+  ASSERT_EQ(runs[1].size(), runs[0].size());
+  size_t measured = 0;
+  for (size_t i = 0; i < runs[0].size(); ++i) {
+    EXPECT_EQ(runs[1][i].frame, runs[0][i].frame);
+    EXPECT_EQ(runs[1][i].pairs, runs[0][i].pairs);
+    EXPECT_EQ(runs[1][i].penetration, runs[0][i].penetration);
+    measured += runs[0][i].penetration.size();
+  }
+  EXPECT_GT(measured, 0u) << "the sphere is closed: every frame measures the cloth against it";
+}
+
+}  // namespace
+}  // namespace snag::cli
