@@ -381,14 +381,16 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
       "next frame, read and compared; preparing = a topology's set-up (weld, the checker's "
       "scene);\nchecking = Checker::check; recording = the frame's record; handing = to the "
       "report stream\n(on a GPU these two are beside the loop, on the recording thread, and "
-      "behind = the loop's\nwait for them); beside the loop, comparing = on the preparing "
-      "thread, each frame's faces and\npositions against the frame before's\n");
-  std::printf("%-8s %9s %10s %9s %10s %9s %9s %9s %10s\n", "backend", "waiting", "preparing",
-              "checking", "recording", "handing", "behind", "loop", "comparing");
+      "behind = the loop's\nwait for them); starting = of waiting and preparing, until the "
+      "first frame's check began;\nbeside the loop, comparing = on the preparing thread, each "
+      "frame's faces and positions\nagainst the frame before's\n");
+  std::printf("%-8s %9s %10s %9s %10s %9s %9s %9s %9s %10s\n", "backend", "waiting", "preparing",
+              "checking", "recording", "handing", "behind", "loop", "starting", "comparing");
   for (const SequenceRow& r : rows)
-    std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %10.3f\n", r.backend.c_str(),
-                r.loop.waiting, r.loop.preparing, r.loop.checking, r.loop.recording, r.loop.handing,
-                r.loop.behind, r.both, r.loop.comparing);
+    std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %9.3f %10.3f\n",
+                r.backend.c_str(), r.loop.waiting, r.loop.preparing, r.loop.checking,
+                r.loop.recording, r.loop.handing, r.loop.behind, r.both, r.loop.starting,
+                r.loop.comparing);
 }
 
 // ---------------------------------------------------------------------------------------------

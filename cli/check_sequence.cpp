@@ -6,6 +6,7 @@
 #include <cstring>
 #include <deque>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -375,6 +376,14 @@ int readers_for(int threads, bool gpu) {
   return gpu ? std::max(threads - 1, 1) : std::clamp(threads / 16, 1, 4);
 }
 
+int frames_ahead_for(int readers, bool gpu, uint64_t frame_file_bytes) {
+  const int least = std::max(readers, 1) + 2;
+  if (!gpu || frame_file_bytes == 0) return least;
+  const uint64_t frames = kReadAheadBytes / (2 * frame_file_bytes);
+  return static_cast<int>(std::clamp<uint64_t>(frames, static_cast<uint64_t>(least),
+                                               std::max(kMostFramesAhead, least)));
+}
+
 int checker_threads_for(int threads, bool gpu) {
   threads = std::max(threads, 1);
   if (gpu || threads < 8) return threads;
@@ -409,7 +418,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
 
   // Frames are read ahead on their own threads, each with its own FrameReaders (which parse
   // only positions while the faces stay those of their previous frame), while the current one
-  // is checked: at most readers + 2 frames being read or waiting for the preparing thread,
+  // is checked: at most `ahead` frames being read or waiting for the preparing thread,
   // kPrepared waiting for this one, the preparing thread's previous and its current, this
   // thread's current and following, and on a GPU the frame before being recorded, whatever the
   // sequence length.
@@ -418,7 +427,17 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   const int workers = checker_threads_for(settings.threads, settings.gpu);
   std::vector<std::vector<io::FrameReader>> per_reader;
   for (int r = 0; r < readers; ++r) per_reader.push_back(reader.make_readers());
-  ScenePrefetcher prefetcher(scene.frames, readers, readers + 2, [&](const seq::Frame& f, int r) {
+  // The first frame's files: what a frame's memory is estimated from.
+  uint64_t frame_file_bytes = 0;
+  for (const scene::ResolvedObject& object : scene.objects) {
+    if (object.still || object.frames.empty()) continue;  // read once, before the frames
+    std::error_code unknown;  // then counted as nothing: the least read-ahead
+    const uintmax_t bytes = std::filesystem::file_size(object.frames[0].path, unknown);
+    if (!unknown) frame_file_bytes += bytes;
+  }
+  const int ahead = std::min(frames_ahead_for(readers, settings.gpu, frame_file_bytes),
+                             std::max(static_cast<int>(scene.frames.size()), readers + 2));
+  ScenePrefetcher prefetcher(scene.frames, readers, ahead, [&](const seq::Frame& f, int r) {
     // Frame numbers are unique and increasing.
     const auto index =
         static_cast<size_t>(std::lower_bound(scene.frames.begin(), scene.frames.end(), f,
@@ -662,6 +681,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         next_moved = following->moved;
       }
       lap(times.preparing);
+      if (i == 0) times.starting = times.waiting + times.preparing;
       // Read by snag's readers, which reject non-finite coordinates.
       detect::FrameResult result =
           checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});

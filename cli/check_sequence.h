@@ -27,6 +27,7 @@ struct LoopTimes {
                          ///< the loop on the recording thread, one frame behind the checks)
   double handing = 0;    ///< on_frame (the report stream takes the record; where recording is)
   double behind = 0;     ///< on a GPU, for the frame before's record and hand-over to be done
+  double starting = 0;   ///< of waiting and preparing, until the first frame's check began
   double comparing = 0;  ///< on the preparing thread: vertex counts, faces and what moved,
                          ///< each frame against the one before (reading's share)
 };
@@ -50,6 +51,18 @@ std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
 /// mostly waits, reading is the work, and every thread but the checker's reads. Readers wait
 /// whenever the frames ahead fill their ring (readers + 2 frames).
 int readers_for(int threads, bool gpu);
+
+/// Frames the readers may hold ahead of the loop (read, or being read, not yet taken), for
+/// frames whose files take `frame_file_bytes` (every object's file of the first frame). On the
+/// CPU readers + 2: the check is the slower side, and frames read further ahead would only wait.
+/// On a GPU as many as kReadAheadBytes holds (kMostFramesAhead at most) at twice their files' bytes
+/// (a parsed frame takes about as much memory as its OBJ text, half again a binary PLY's), at least
+/// readers + 2: the loop's start (the first frame parsed in full, its topology, the tree) takes ~25
+/// ms at 36K triangles on the H100's host, and readers that stopped after readers + 2 frames then
+/// sat idle while a GPU check keeps up with them afterwards.
+int frames_ahead_for(int readers, bool gpu, uint64_t frame_file_bytes);
+constexpr uint64_t kReadAheadBytes = uint64_t{256} << 20;
+constexpr int kMostFramesAhead = 4096;  ///< however small the frames
 
 /// The checker's worker threads in a run of `threads`. On the CPU with 8 threads or more, the
 /// readers' threads are taken out, so that the run stays within `threads`: OpenMP's workers

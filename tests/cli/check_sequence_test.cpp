@@ -196,5 +196,21 @@ TEST(CheckSequence, AScenesPenetrationIsTheSameRecordedBesideTheChecks) {
   EXPECT_GT(measured, 0u) << "the sphere is closed: every frame measures the cloth against it";
 }
 
+TEST(CheckSequence, GpuRunsReadAheadWithinTheirByteBudget) {
+  // The CPU, and frames of unknown size: readers + 2.
+  EXPECT_EQ(frames_ahead_for(1, false, 1'000'000), 3);
+  EXPECT_EQ(frames_ahead_for(15, false, 1'000'000), 17);
+  EXPECT_EQ(frames_ahead_for(7, true, 0), 9);
+  // A GPU: as many as the budget holds at twice their files' bytes...
+  for (const uint64_t bytes : {uint64_t{100'000}, uint64_t{1'200'000}, uint64_t{5'000'000}}) {
+    const int ahead = frames_ahead_for(7, true, bytes);
+    EXPECT_LE(static_cast<uint64_t>(ahead) * 2 * bytes, kReadAheadBytes) << bytes;
+    EXPECT_GT(static_cast<uint64_t>(ahead + 1) * 2 * bytes, kReadAheadBytes) << bytes;
+  }
+  // ... at least readers + 2 (large frames), at most kMostFramesAhead (tiny ones).
+  EXPECT_EQ(frames_ahead_for(15, true, uint64_t{1} << 30), 17);
+  EXPECT_EQ(frames_ahead_for(15, true, 100), kMostFramesAhead);
+}
+
 }  // namespace
 }  // namespace snag::cli
