@@ -161,8 +161,9 @@ void prepare_frames(ScenePrefetcher& prefetcher, const scene::ResolvedScene& sce
       // The frame before had the topology's faces, or started a topology of its own.
       if (previous) {
         const scene::SceneFrame& before = previous->item;
-        prepared.topology_changed = !same_faces(scene_frame.mesh.triangles, before.mesh.triangles) ||
-                                    layout.triangle_begin != before.layout.triangle_begin;
+        prepared.topology_changed =
+            !same_faces(scene_frame.mesh.triangles, before.mesh.triangles) ||
+            layout.triangle_begin != before.layout.triangle_begin;
         prepared.moved = moved_between(before, scene_frame);
       }
       prepared.frame = frame;
@@ -216,8 +217,9 @@ struct CheckedFrame {
 /// waits for the one before). On the CPU the record is made in add() itself: there the check's
 /// workers have every core, and a penetration meter's OpenMP loops beside theirs would compete.
 ///
-/// The recording thread reads what the loop's thread set up for the frame's topology (the
-/// checker's topology, the meters): the loop calls finish() before it changes them.
+/// A record reads its frame, its result, and the penetration meters the loop's thread set up for
+/// the frame's topology: the loop calls finish() before it changes them (at a topology's first
+/// frame), so that a record never meets the next topology's meters.
 class FrameRecorder {
  public:
   FrameRecorder(bool beside, std::function<void(CheckedFrame&&)> record)
@@ -427,10 +429,11 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   const int workers = checker_threads_for(settings.threads, settings.gpu);
   std::vector<std::vector<io::FrameReader>> per_reader;
   for (int r = 0; r < readers; ++r) per_reader.push_back(reader.make_readers());
-  // The first frame's files: what a frame's memory is estimated from.
+  // The first frame's files: what a frame's memory is estimated from. A still object is read
+  // once, but every frame read holds a copy of it (SceneReader lays the objects end to end).
   uint64_t frame_file_bytes = 0;
   for (const scene::ResolvedObject& object : scene.objects) {
-    if (object.still || object.frames.empty()) continue;  // read once, before the frames
+    if (object.frames.empty()) continue;
     std::error_code unknown;  // then counted as nothing: the least read-ahead
     const uintmax_t bytes = std::filesystem::file_size(object.frames[0].path, unknown);
     if (!unknown) frame_file_bytes += bytes;
@@ -487,7 +490,6 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       record.triangles = static_cast<int32_t>(mesh.triangles.size());
       for (int64_t p : scene_frame.polygons) record.polygons += p;
       report::copy_check_counts(result, record);
-      const detect::Topology& topology = *checker.topology();
       // A scene of one whole mesh has the file's ids (no table).
       const auto file_id = [&](int32_t t) {
         return scene_frame.file_triangle.empty() ? t : scene_frame.file_triangle[t];
@@ -500,7 +502,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       for (const detect::CheckOutcome& c : result.checks)
         checks.push_back({c.part_a, c.part_b, 0, c.reused, c.seconds});
       for (const detect::FacePair& p : result.pairs) {
-        const int32_t oa = topology.part_of(p.a), ob = topology.part_of(p.b);
+        const int32_t oa = layout.part_of(p.a), ob = layout.part_of(p.b);
         if (ignored(scene, oa, group_name(p.a), ob, group_name(p.b))) continue;
         record.pairs.push_back({file_id(p.a), file_id(p.b), p.kind, mesh.source_polygon[p.a],
                                 mesh.source_polygon[p.b], oa, ob});
@@ -509,7 +511,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       }
       std::sort(record.pairs.begin(), record.pairs.end(), report::pair_order);
       for (int32_t t : result.degenerate)
-        record.degenerate.push_back({file_id(t), mesh.source_polygon[t], topology.part_of(t)});
+        record.degenerate.push_back({file_id(t), mesh.source_polygon[t], layout.part_of(t)});
       record.checks = std::move(checks);
       for (int32_t o = 0; o < object_count; ++o) {
         const detect::PartOutcome& part = result.parts[o];
@@ -571,6 +573,11 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       lap(times.waiting);
 
       const size_t i = current->frame->index;
+      if (i == 0 || current->topology_changed) {
+        // The frames before are recorded with the topology and meters they were checked with.
+        recorder.finish();
+        lap(behind);
+      }
       const auto read_started = Clock::now();  // welding counts as reading
       const scene::SceneFrame& scene_frame = current->frame->item;
       const mesh::Mesh& mesh = scene_frame.mesh;
@@ -585,8 +592,6 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         }
 
       if (i == 0 || topology_changed) {
-        // The frames before are recorded with the topology and meters they were checked with.
-        recorder.finish();
         // Welding is decided once per topology, on its first frame, per object with its own
         // tolerance: seams stay closed while the cloth moves, and a weld that changed from
         // frame to frame would rebuild the tree.

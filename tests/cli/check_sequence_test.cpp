@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -161,39 +162,76 @@ TEST(CheckSequence, AReportWritersErrorStopsTheRunAndIsThrown) {
                      },
                      [](const std::string&) {}),
                  std::runtime_error);
-    // The loop stops at the failed frame's turn: at most the frame checked meanwhile follows it.
+    // Nothing is handed on after the failed frame (beside the checks, the frame checked
+    // meanwhile is dropped with the error).
     EXPECT_EQ(handed, 3);
   }
 }
 
-TEST(CheckSequence, AScenesPenetrationIsTheSameRecordedBesideTheChecks) {
-  const fs::path drape = snag::test::source_dir() / "samples" / "drape";
-  const scene::Scene scene = scene::scene_from_flags(
-      (drape / "drape.%04d.obj").string(),
-      {(snag::test::source_dir() / "samples" / "drape_sphere.obj").string()}, std::nullopt);
-  const scene::ResolvedScene resolved = scene::resolve_scene(scene, "");
-  std::vector<std::vector<report::FrameRecord>> runs;
-  for (const bool beside : {false, true}) {
-    const std::unique_ptr<detect::Checker> checker = cpu_checker();
-    report::Inputs inputs;
-    inputs.objects.resize(resolved.objects.size());
-    Handed handed;
-    check_scene(
-        resolved, *checker, settings_for(beside), /*scene_report=*/true, inputs,
-        [&](report::FrameRecord&& r) { handed.take(std::move(r)); }, [](const std::string&) {});
-    EXPECT_FALSE(handed.overlapped);
-    runs.push_back(std::move(handed.records));
+/// The drape frames copied into `dir`, the last face of every frame from the 6th on left out: a
+/// topology change there (the vertices stay).
+fs::path drape_with_a_topology_change(const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::vector<seq::Frame> frames = drape_frames();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    std::ifstream in(frames[i].path);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    if (i >= 5) {
+      const auto last_face = std::find_if(
+          lines.rbegin(), lines.rend(), [](const std::string& l) { return l.rfind("f ", 0) == 0; });
+      lines.erase(std::next(last_face).base());
+    }
+    std::ofstream out(dir / frames[i].path.filename());
+    for (const std::string& line : lines) out << line << "\n";
   }
-  ASSERT_EQ(runs[0].size(), resolved.frames.size());
-  ASSERT_EQ(runs[1].size(), runs[0].size());
-  size_t measured = 0;
-  for (size_t i = 0; i < runs[0].size(); ++i) {
-    EXPECT_EQ(runs[1][i].frame, runs[0][i].frame);
-    EXPECT_EQ(runs[1][i].pairs, runs[0][i].pairs);
-    EXPECT_EQ(runs[1][i].penetration, runs[0][i].penetration);
-    measured += runs[0][i].penetration.size();
+  return dir / "drape.%04d.obj";
+}
+
+/// A scene (the drape cloth against the closed sphere, penetration measured) run both ways,
+/// with and without a topology change halfway: the same records.
+TEST(CheckSequence, AScenesRecordsAreTheSameRecordedBesideTheChecks) {
+  const fs::path changed_dir = fs::temp_directory_path() / "snag_check_sequence_topology";
+  for (const bool change : {false, true}) {
+    SCOPED_TRACE(change ? "faces change at the 6th frame" : "one topology");
+    const std::string cloth =
+        change ? drape_with_a_topology_change(changed_dir).string()
+               : (snag::test::source_dir() / "samples" / "drape" / "drape.%04d.obj").string();
+    const scene::Scene scene = scene::scene_from_flags(
+        cloth, {(snag::test::source_dir() / "samples" / "drape_sphere.obj").string()},
+        std::nullopt);
+    const scene::ResolvedScene resolved = scene::resolve_scene(scene, "");
+    std::vector<std::vector<report::FrameRecord>> runs;
+    for (const bool beside : {false, true}) {
+      const std::unique_ptr<detect::Checker> checker = cpu_checker();
+      report::Inputs inputs;
+      inputs.objects.resize(resolved.objects.size());
+      Handed handed;
+      check_scene(
+          resolved, *checker, settings_for(beside), /*scene_report=*/true, inputs,
+          [&](report::FrameRecord&& r) { handed.take(std::move(r)); }, [](const std::string&) {});
+      EXPECT_FALSE(handed.overlapped);
+      runs.push_back(std::move(handed.records));
+    }
+    ASSERT_EQ(runs[0].size(), resolved.frames.size());
+    ASSERT_EQ(runs[1].size(), runs[0].size());
+    size_t measured = 0, changes = 0;
+    for (size_t i = 0; i < runs[0].size(); ++i) {
+      const report::FrameRecord &inline_record = runs[0][i], &beside = runs[1][i];
+      EXPECT_EQ(beside.frame, inline_record.frame);
+      EXPECT_EQ(beside.triangles, inline_record.triangles);
+      EXPECT_EQ(beside.topology_changed, inline_record.topology_changed);
+      EXPECT_EQ(beside.pairs, inline_record.pairs);
+      EXPECT_EQ(beside.degenerate.size(), inline_record.degenerate.size());
+      EXPECT_EQ(beside.penetration, inline_record.penetration);
+      measured += inline_record.penetration.size();
+      changes += inline_record.topology_changed;
+    }
+    EXPECT_GT(measured, 0u) << "the sphere is closed: the cloth is measured against it";
+    EXPECT_EQ(changes, change ? 1u : 0u);
   }
-  EXPECT_GT(measured, 0u) << "the sphere is closed: every frame measures the cloth against it";
+  fs::remove_all(changed_dir);
 }
 
 TEST(CheckSequence, GpuRunsReadAheadWithinTheirByteBudget) {

@@ -185,10 +185,14 @@ Topology make_topology(std::span<const geom::Tri> triangles, int32_t vertex_coun
   return make_scene_topology(triangles, vertex_count, std::move(layout), {PartCheck{0, 0}});
 }
 
+int32_t PartLayout::part_of(int32_t t) const {
+  return static_cast<int32_t>(
+      std::upper_bound(triangle_begin.begin() + 1, triangle_begin.end() - 1, t) -
+      (triangle_begin.begin() + 1));
+}
+
 int32_t Topology::part_of(int32_t t) const {
-  const auto& begin = layout.triangle_begin;
-  return static_cast<int32_t>(std::upper_bound(begin.begin() + 1, begin.end() - 1, t) -
-                              (begin.begin() + 1));
+  return layout.part_of(t);
 }
 
 Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t vertex_count,

@@ -20,6 +20,8 @@ struct PartLayout {
   std::vector<int32_t> triangle_begin = {0, 0};  ///< part count + 1 entries, non-decreasing
   std::vector<int32_t> vertex_begin = {0, 0};
   int32_t part_count() const { return static_cast<int32_t>(triangle_begin.size()) - 1; }
+  /// The part triangle t is in.
+  int32_t part_of(int32_t t) const;
 };
 
 /// Two parts checked against each other, a <= b; a == b checks the part's self-intersections.
