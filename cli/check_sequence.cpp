@@ -574,7 +574,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
 
       const size_t i = current->frame->index;
       if (i == 0 || current->topology_changed) {
-        // The frames before are recorded with the topology and meters they were checked with.
+        // The frames before are recorded with the meters set up for their topology.
         recorder.finish();
         lap(behind);
       }
