@@ -10,13 +10,14 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "cli/run_snag.h"
 #include "snag/detect/cpu_backend.h"
 #include "snag/detect/resolve.h"
 #include "snag/error.h"
@@ -111,23 +112,24 @@ TEST(CheckSequence, RecordsAreEachFramesOwnCheckInOrderBothWays) {
   }
 }
 
-/// `frames` copied into `dir`, the copy of frame `bad` (1-based position) given a face that
-/// names a vertex the file does not have.
-std::vector<seq::Frame> copies_with_a_bad_frame(const std::vector<seq::Frame>& frames,
-                                                const fs::path& dir, size_t bad) {
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+/// The drape frames copied into `dir`, the text of the i-th (from 0) changed by edit(i, text).
+std::vector<seq::Frame> drape_copies(const fs::path& dir,
+                                     const std::function<void(size_t, std::string&)>& edit) {
+  const std::vector<seq::Frame> frames = drape_frames();
   for (size_t i = 0; i < frames.size(); ++i) {
-    const fs::path copy = dir / frames[i].path.filename();
-    fs::copy_file(frames[i].path, copy);
-    if (i + 1 == bad) std::ofstream(copy, std::ios::app) << "f 1 2 999999\n";
+    std::string text = snag::test::read_text(frames[i].path);
+    edit(i, text);
+    snag::test::write_text(dir / frames[i].path.filename(), text);
   }
   return seq::resolve_sequence(dir.string());
 }
 
 TEST(CheckSequence, ABadFrameIsThrownAfterEveryFrameBeforeItIsHandedOn) {
-  const fs::path dir = fs::temp_directory_path() / "snag_check_sequence_bad_frame";
-  const std::vector<seq::Frame> frames = copies_with_a_bad_frame(drape_frames(), dir, 5);
+  // The 5th frame's copy gets a face that names a vertex the file does not have.
+  const snag::test::TempDir dir;
+  const std::vector<seq::Frame> frames = drape_copies(dir.path(), [](size_t i, std::string& text) {
+    if (i == 4) text += "f 1 2 999999\n";
+  });
   for (const bool beside : {false, true}) {
     SCOPED_TRACE(beside ? "records beside the checks" : "records on the loop's thread");
     const std::unique_ptr<detect::Checker> checker = cpu_checker();
@@ -145,7 +147,6 @@ TEST(CheckSequence, ABadFrameIsThrownAfterEveryFrameBeforeItIsHandedOn) {
     ASSERT_EQ(handed.records.size(), 4u);
     for (size_t i = 0; i < 4; ++i) EXPECT_EQ(handed.records[i].frame, frames[i].number);
   }
-  fs::remove_all(dir);
 }
 
 TEST(CheckSequence, AReportWritersErrorStopsTheRunAndIsThrown) {
@@ -168,38 +169,25 @@ TEST(CheckSequence, AReportWritersErrorStopsTheRunAndIsThrown) {
   }
 }
 
-/// The drape frames copied into `dir`, the last face of every frame from the 6th on left out: a
-/// topology change there (the vertices stay).
-fs::path drape_with_a_topology_change(const fs::path& dir) {
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::vector<seq::Frame> frames = drape_frames();
-  for (size_t i = 0; i < frames.size(); ++i) {
-    std::ifstream in(frames[i].path);
-    std::vector<std::string> lines;
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    if (i >= 5) {
-      const auto last_face = std::find_if(
-          lines.rbegin(), lines.rend(), [](const std::string& l) { return l.rfind("f ", 0) == 0; });
-      lines.erase(std::next(last_face).base());
-    }
-    std::ofstream out(dir / frames[i].path.filename());
-    for (const std::string& line : lines) out << line << "\n";
-  }
-  return dir / "drape.%04d.obj";
-}
-
 /// A scene (the drape cloth against the closed sphere, penetration measured) run both ways,
 /// with and without a topology change halfway: the same records.
 TEST(CheckSequence, AScenesRecordsAreTheSameRecordedBesideTheChecks) {
-  const fs::path changed_dir = fs::temp_directory_path() / "snag_check_sequence_topology";
+  // Copies of the drape frames whose last face is left out from the 6th frame on: a topology
+  // change there (the vertices stay).
+  const snag::test::TempDir changed;
+  drape_copies(changed.path(), [](size_t i, std::string& text) {
+    if (i < 5) return;
+    const size_t face = text.rfind("\nf ") + 1;
+    const size_t end = text.find('\n', face);
+    text.erase(face, end == std::string::npos ? std::string::npos : end + 1 - face);
+  });
   for (const bool change : {false, true}) {
     SCOPED_TRACE(change ? "faces change at the 6th frame" : "one topology");
-    const std::string cloth =
-        change ? drape_with_a_topology_change(changed_dir).string()
-               : (snag::test::source_dir() / "samples" / "drape" / "drape.%04d.obj").string();
+    const fs::path cloth =
+        (change ? changed.path() : snag::test::source_dir() / "samples" / "drape") /
+        "drape.%04d.obj";
     const scene::Scene scene = scene::scene_from_flags(
-        cloth, {(snag::test::source_dir() / "samples" / "drape_sphere.obj").string()},
+        cloth.string(), {(snag::test::source_dir() / "samples" / "drape_sphere.obj").string()},
         std::nullopt);
     const scene::ResolvedScene resolved = scene::resolve_scene(scene, "");
     std::vector<std::vector<report::FrameRecord>> runs;
@@ -231,7 +219,6 @@ TEST(CheckSequence, AScenesRecordsAreTheSameRecordedBesideTheChecks) {
     EXPECT_GT(measured, 0u) << "the sphere is closed: the cloth is measured against it";
     EXPECT_EQ(changes, change ? 1u : 0u);
   }
-  fs::remove_all(changed_dir);
 }
 
 TEST(CheckSequence, GpuRunsReadAheadWithinTheirByteBudget) {
