@@ -1,7 +1,8 @@
 // report.json composed of pieces, so that ReportStream can write its two arrays that grow with
 // the run (frames, into the file itself, and inputs.files) as frames finish and everything
 // else at the end, while the bytes stay those nlohmann's dump(2) gives for the whole document
-// (two-space indentation, "key": value, one element or member per line, [] for an empty array).
+// (two-space indentation, "key": value, one element or member per line, [] for an empty array),
+// except that each of a frame's pairs is one line, as dump() writes the pair's object.
 // Private to snag::lib; json.h's report_json is the same composition in memory.
 #pragma once
 
