@@ -10,7 +10,8 @@ import csv
 import json
 import sys
 
-IGNORED_KEYS = {'seconds', 'times', 'backend', 'threads', 'created', 'elapsed_seconds'}
+IGNORED_KEYS = {'seconds', 'times', 'backend', 'backend_requested', 'threads', 'created',
+                'elapsed_seconds'}
 
 
 def frames_rows(folder):
