@@ -122,48 +122,33 @@ void ReportStream::format_loop() {
 }
 
 void ReportStream::write_ready(std::unique_lock<std::mutex>& lock) {
-  for (bool progressed = true; progressed;) {
-    progressed = false;
-    for (const Part part : {csv_part, json_part}) {
-      if (writing_[part] || unwritten_.empty()) continue;
-      // Frames leave the queue only once both parts are written: this part's next frame, if
-      // handed over, is in it.
-      const uint64_t next = parts_written_[part] - unwritten_.front().sequence;
-      if (next >= unwritten_.size() || !unwritten_[next].formatted) continue;
-      Unwritten& entry = unwritten_[next];
-      writing_[part] = true;
-      unlocked_unless_failed(lock, write_error_, [&] { write_part(entry, part); });
-      writing_[part] = false;
-      ++parts_written_[part];
-      progressed = true;
+  if (writing_) return;
+  writing_ = true;
+  while (!unwritten_.empty() && unwritten_.front().formatted) {
+    // The frame stays in the queue while it is written: add() counts it as unwritten.
+    Unwritten& entry = unwritten_.front();
+    unlocked_unless_failed(lock, write_error_, [&] { write_frame(entry); });
+    for (std::string* text : {&entry.pairs_text, &entry.json_text}) {
+      text->clear();  // its capacity stays for a later frame
+      spare_texts_.push_back(std::move(*text));
     }
-    while (!unwritten_.empty() && unwritten_.front().sequence < parts_written_[csv_part] &&
-           unwritten_.front().sequence < parts_written_[json_part]) {
-      Unwritten& entry = unwritten_.front();
-      for (std::string* text : {&entry.pairs_text, &entry.json_text}) {
-        text->clear();  // its capacity stays for a later frame
-        spare_texts_.push_back(std::move(*text));
-      }
-      unwritten_.pop_front();
-      written_.notify_all();
-    }
+    unwritten_.pop_front();
+    written_.notify_all();
   }
+  writing_ = false;
 }
 
-void ReportStream::write_part(Unwritten& entry, Part part) {
+void ReportStream::write_frame(Unwritten& entry) {
   const auto write = [&](StagedFile& file, const std::string& text) {
     file.out().write(text.data(), static_cast<std::streamsize>(text.size()));
   };
-  if (part == csv_part) {
-    write(files_->pairs_csv, entry.pairs_text);
-    write_frames_row(files_->frames_csv.out(), entry.frame, objects_);
-    files_->file_names.out() << json_file_element(entry.frame.file, entry.sequence == 0);
-    for (const StagedFile* f : {&files_->pairs_csv, &files_->frames_csv, &files_->file_names})
-      f->check();
-  } else {
-    write(files_->report_json, entry.json_text);
-    files_->report_json.check();
-  }
+  write(files_->pairs_csv, entry.pairs_text);
+  write_frames_row(files_->frames_csv.out(), entry.frame, objects_);
+  files_->file_names.out() << json_file_element(entry.frame.file, entry.sequence == 0);
+  write(files_->report_json, entry.json_text);
+  for (const StagedFile* f :
+       {&files_->pairs_csv, &files_->frames_csv, &files_->file_names, &files_->report_json})
+    f->check();
 }
 
 std::exception_ptr ReportStream::stop_writer() {

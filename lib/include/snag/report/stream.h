@@ -16,14 +16,10 @@
 //
 // A frame's rows and record are formatted by one of the stream's threads (up to write_ahead of
 // them, each formatting a frame of its own), and written in the order the frames were added by
-// whichever of them finds the next frame formatted: its pairs.csv, frames.csv and file-name
-// part by one thread while its report.json part may be written by another (each part's frames
-// in order). One thread keeps up with a CPU check; a GPU checks a 3K-pair frame faster than one
-// thread formats its ~280 KB of text (a pair is ~30 bytes of pairs.csv and ~60 of report.json,
-// see append_pairs_array in json.cpp), and copying the text into the page cache is as much
-// again. On the H100's 16-core host, 1,000 frames of 2,274 pairs through the stream alone took
-// 0.100 ms a frame with 4 formatters and one writer, 0.084 with 8 and one, 0.063 with 8 and a
-// writer per part (medians of three runs, 0.095-0.118 with 4 and two).
+// whichever of them finds the next frame formatted. One thread keeps up with a CPU check; a
+// GPU checks a 3K-pair frame faster than one thread formats its ~280 KB of text (and writing
+// them, one thread's copy into the page cache, is most of what is left to the stream: a pair is
+// ~30 bytes of pairs.csv and ~60 of report.json, see append_pairs_array in json.cpp).
 #pragma once
 
 #include <condition_variable>
@@ -78,7 +74,7 @@ class ReportStream {
   void add(FrameRecord frame);
 
   /// Frames handed over and not yet written, at most: what the memory bound is counted in.
-  static constexpr size_t write_ahead = 8;
+  static constexpr size_t write_ahead = 4;
 
   /// The summary of the frames added so far (worst_frame counts them in the order added).
   const Summary& summary() const;
@@ -104,21 +100,13 @@ class ReportStream {
     std::string pairs_text, json_text;
   };
 
-  /// What a frame writes, in two parts that go to different files and can be written side by
-  /// side by two threads (each part's frames in order): its pairs.csv rows, frames.csv row and
-  /// file name; its report.json element. Copying a frame's text into the page cache is most of
-  /// the stream's time, and report.json is two thirds of the bytes.
-  enum Part { csv_part = 0, json_part = 1 };
-
   /// A formatter thread: takes the next frame not yet taken, formats it, then writes what is
   /// ready (write_ready).
   void format_loop();
-  /// With the lock held: for each part not being written by another thread, writes that part
-  /// of the formatted frames whose turn it is, in order, and drops the frames written whole
-  /// from the front of the queue; returns when neither part has a frame ready for it (another
-  /// thread writing one finds the frames formatted meanwhile when its write is done).
+  /// With the lock held: writes the formatted frames at the front of the queue, in order,
+  /// unless another thread is writing (it will find them when its write is done).
   void write_ready(std::unique_lock<std::mutex>& lock);
-  void write_part(Unwritten& frame, Part part);
+  void write_frame(Unwritten& frame);
   /// Waits until every frame handed over is written, then stops the formatter threads. Returns
   /// their error, if a write failed.
   std::exception_ptr stop_writer();
@@ -138,8 +126,7 @@ class ReportStream {
   std::deque<Unwritten> unwritten_;  ///< in sequence order; references stay valid at its ends
   uint64_t handed_ = 0;              ///< frames handed over
   uint64_t taken_ = 0;               ///< frames taken by a formatter (the next one's sequence)
-  bool writing_[2] = {false, false};  ///< per Part: a thread is writing that part
-  uint64_t parts_written_[2] = {0, 0};  ///< per Part: how many frames have that part written
+  bool writing_ = false;             ///< a thread is in write_ready's loop
   std::vector<std::string> spare_texts_;
   bool closing_ = false;
   std::exception_ptr write_error_;
