@@ -2,7 +2,6 @@
 // same frames (generated cloth at the paper's sizes, the shared cloth-ball frames, and any
 // --input sequence), with a check that both found the same pairs. A benchmark, not a test:
 // it prints a table and fails only when the pairs differ.
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -24,6 +23,7 @@
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
+#include "snag/threads.h"
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/cgal_resolver.h"
 
@@ -188,7 +188,7 @@ int run_bench_cpu(const BenchOptions& o) {
 
   std::vector<Row> rows;
   for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
-  print_table(rows, o.threads > 0 ? o.threads : omp_get_max_threads(),
+  print_table(rows, thread_count(o.threads),
               detect::cpu_walk_lanes(walk_width(o.walk_lanes)));
   const bool all_same = std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; });
   if (!all_same) throw InternalError("snag and CGAL found different pairs (see the table)");

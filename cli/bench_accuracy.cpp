@@ -29,6 +29,7 @@
 #include "snag/mesh/weld.h"
 #include "snag/report/csv.h"
 #include "snag/report/write.h"
+#include "snag/threads.h"
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/exact_modes.h"
 
@@ -311,7 +312,7 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
 }
 
 int run_bench_accuracy(const BenchAccuracyOptions& o) {
-  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const int threads = thread_count(o.threads);
   const char* command = "snag bench accuracy";
   if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
 

@@ -2,7 +2,6 @@
 // the same frames and the seed paper's table, with a check that both backends give the same
 // filtered frame (pairs, kinds, uncertain tests, counts) on every frame. A benchmark, not a
 // test: it prints a table and fails only when the backends differ.
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,6 +20,7 @@
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
+#include "snag/threads.h"
 
 #ifdef SNAG_HAVE_CUDA
 #include "snag/cuda/cuda_backend.h"
@@ -309,7 +309,7 @@ int run_bench_gpu(const BenchGpuOptions& o) {
   for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
   auto probe = make_backend("cuda", o.threads, o.device);
   print_tables(rows, dynamic_cast<cuda::CudaBackend&>(*probe).device_name(),
-               o.threads > 0 ? o.threads : omp_get_max_threads());
+               thread_count(o.threads));
   if (!std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; }))
     throw InternalError("the CPU and CUDA backends gave different results (see the table)");
   return 0;

@@ -10,7 +10,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fcntl.h>
-#include <omp.h>
 #include <unistd.h>
 #include <assimp/Importer.hpp>
 
@@ -42,6 +41,7 @@
 #include "snag/report/stream.h"
 #include "snag/seq/prefetch.h"
 #include "snag/seq/sequence.h"
+#include "snag/threads.h"
 
 namespace snag::cli {
 
@@ -500,7 +500,7 @@ CLI::App* add_bench_io_command(CLI::App& bench, BenchIoOptions& o) {
 
 int run_bench_io(const BenchIoOptions& o) {
   ScratchDir scratch;
-  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const int threads = thread_count(o.threads);
 
   // The reader cases: the generated cloth as OBJ, binary PLY and ascii PLY, the shared data's
   // big-endian PLY, and every --input.

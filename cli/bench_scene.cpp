@@ -13,7 +13,6 @@
 // Checking is timed from memory (frames read beforehand), reading one thread apart, and the
 // frame loop of `snag check` as a whole. A benchmark, not a test: it prints the tables and fails
 // only when something cannot run or the frame loop finds other pairs than checking from memory.
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -36,6 +35,7 @@
 #include "snag/scene/scene.h"
 #include "snag/scene/scene_frames.h"
 #include "snag/seq/sequence.h"
+#include "snag/threads.h"
 
 namespace snag::cli {
 
@@ -519,7 +519,7 @@ CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& o) {
 }
 
 int run_bench_scene(const BenchSceneOptions& o) {
-  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const int threads = thread_count(o.threads);
   // The backends, each checked before any work: a GPU asked for and missing is an error, one
   // merely possible (both) a note under the table.
   std::vector<std::string> backends;

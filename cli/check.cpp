@@ -1,6 +1,5 @@
 // `snag check SEQUENCE`: every frame of a sequence checked for self-intersections, a summary on
 // standard output and, with --out, the reports.
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -25,6 +24,7 @@
 #include "snag/scene/scene.h"
 #include "snag/scene/scene_frames.h"
 #include "snag/seq/sequence.h"
+#include "snag/threads.h"
 #include "snag/validators/exact_modes.h"
 
 namespace snag::cli {
@@ -254,7 +254,7 @@ int run_check(const CheckOptions& o) {
   if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
 
   // The run's threads are the checker's and its readers' (checker_threads_for).
-  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  const int threads = thread_count(o.threads);
   const bool on_gpu = o.backend == "cuda" || (o.backend == "auto" && cuda_devices() > 0);
   const int checker_threads = checker_threads_for(threads, on_gpu);
   auto backend = make_backend(o.backend, checker_threads, o.device);
