@@ -121,5 +121,104 @@ TEST(Predicates, NearDegenerateSignsAreUncertainNotWrong) {
   EXPECT_LT(certain, 3 * 65);  // most of these are beyond the filter
 }
 
+/// Random pairs of triangles on a small integer grid (many touching configurations: ends of
+/// the two segments that coincide, edges through the other's edges or corners), six vertices,
+/// no vertex shared. Calls f(points, sides of the first against the second's plane, sides of
+/// the second) for each pair whose triangles straddle each other's planes strictly.
+template <class F>
+void for_each_straddling_pair(uint32_t seed, int trials, int extent, F&& f) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> coord(-extent, extent);
+  std::vector<geom::Vec3d> points(6);
+  const geom::Tri a{{0, 1, 2}}, b{{3, 4, 5}};
+  for (int trial = 0; trial < trials; ++trial) {
+    for (auto& p : points) p = {double(coord(rng)), double(coord(rng)), double(coord(rng))};
+    const IntegerPredicates exact{points.data()};
+    if (geom::is_degenerate(exact, 0, 1, 2) != geom::Answer::no ||
+        geom::is_degenerate(exact, 3, 4, 5) != geom::Answer::no)
+      continue;
+    geom::Sign sa[3], sb[3];
+    geom::corner_sides(exact, a, b, sa);
+    geom::corner_sides(exact, b, a, sb);
+    if (!geom::strict_sides(sa) || !geom::strict_sides(sb) || geom::lone_corner(sa) < 0 ||
+        geom::lone_corner(sb) < 0)
+      continue;
+    f(points, sa, sb);
+  }
+}
+
+/// The edge-by-edge answers of f's edges against x (edge k: corners k, k + 1).
+template <class P>
+void edge_answers(const P& pred, const geom::Tri& f, const geom::Tri& x, const geom::Sign side[3],
+                  geom::Answer answers[3]) {
+  for (int k = 0; k < 3; ++k)
+    answers[k] =
+        geom::edge_hits_triangle(pred, f.v[k], f.v[(k + 1) % 3], x, side[k], side[(k + 1) % 3]);
+}
+
+TEST(StraddlingEdgeHits, ExactlyTheEdgeTestsAnswers) {
+  // With exact predicates the joint decision answers every edge as the edge tests do,
+  // touching configurations (zero orientations among its four) included.
+  const geom::Tri a{{0, 1, 2}}, b{{3, 4, 5}};
+  int pairs = 0, hits = 0, touching = 0;
+  for_each_straddling_pair(
+      2024, 400000, 3,
+      [&](const std::vector<geom::Vec3d>& points, const geom::Sign sa[3], const geom::Sign sb[3]) {
+        const IntegerPredicates exact{points.data()};
+        geom::Answer joint_a[3], joint_b[3], edges_a[3], edges_b[3];
+        ASSERT_TRUE(geom::straddling_edge_hits(exact, a, b, sa, sb, joint_a, joint_b));
+        edge_answers(exact, a, b, sa, edges_a);
+        edge_answers(exact, b, a, sb, edges_b);
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_EQ(joint_a[k], edges_a[k])
+              << "pair " << pairs << ", edge " << k << " of the first";
+          ASSERT_EQ(joint_b[k], edges_b[k])
+              << "pair " << pairs << ", edge " << k << " of the second";
+          hits += (edges_a[k] == geom::Answer::yes) + (edges_b[k] == geom::Answer::yes);
+        }
+        // A hit count other than 0 or 2 is a segment end shared by the two segments.
+        const int pair_hits =
+            (edges_a[0] == geom::Answer::yes) + (edges_a[1] == geom::Answer::yes) +
+            (edges_a[2] == geom::Answer::yes) + (edges_b[0] == geom::Answer::yes) +
+            (edges_b[1] == geom::Answer::yes) + (edges_b[2] == geom::Answer::yes);
+        touching += pair_hits != 0 && pair_hits != 2;
+        ++pairs;
+      });
+  // The grid must have produced plenty of each kind of case.
+  EXPECT_GT(pairs, 5000);
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(touching, 200);
+}
+
+TEST(StraddlingEdgeHits, FilteredAnswersAreExactOrDeferred) {
+  // Through the double filter the joint decision either defers (returns false) or answers
+  // what the exact edge tests answer; on a fine grid it defers rarely.
+  const geom::Tri a{{0, 1, 2}}, b{{3, 4, 5}};
+  for (const int extent : {3, 1 << 19}) {
+    int pairs = 0, deferred = 0;
+    for_each_straddling_pair(
+        77 + extent, 200000, extent,
+        [&](const std::vector<geom::Vec3d>& points, const geom::Sign sa[3],
+            const geom::Sign sb[3]) {
+          const IntegerPredicates exact{points.data()};
+          const geom::FilteredPredicates filtered{points.data()};
+          geom::Answer joint_a[3], joint_b[3], edges_a[3], edges_b[3];
+          ++pairs;
+          if (!geom::straddling_edge_hits(filtered, a, b, sa, sb, joint_a, joint_b)) {
+            ++deferred;
+            return;
+          }
+          edge_answers(exact, a, b, sa, edges_a);
+          edge_answers(exact, b, a, sb, edges_b);
+          for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(joint_a[k], edges_a[k]) << "extent " << extent << ", pair " << pairs;
+            ASSERT_EQ(joint_b[k], edges_b[k]) << "extent " << extent << ", pair " << pairs;
+          }
+        });
+    EXPECT_GT(pairs, 5000) << "extent " << extent;
+    if (extent > 3) EXPECT_LT(deferred, pairs / 100) << "extent " << extent;
+  }
+}
+
 }  // namespace
 }  // namespace snag::test

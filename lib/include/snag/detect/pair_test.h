@@ -98,6 +98,20 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
   });
 }
 
+/// Reports the answers of straddling_edge_hits for the edges triangle `t` represents (t shares
+/// no vertex with x, so every one of them is tested), in test_owned_edges' order.
+template <class Sink>
+SNAG_HD_INLINE void report_owned_edges(const TopologyView& topo, int32_t t, uint8_t owned,
+                                       int32_t x, const geom::Answer hits[3], Sink& sink) {
+  for (int k = 0; k < 3; ++k) {
+    if (!(owned & (1u << k))) continue;
+    if (hits[k] == geom::Answer::yes)
+      sink.hit(topo.triangle_edges[t][k], x);
+    else
+      sink.miss();
+  }
+}
+
 /// What the pair tests read of one frame: the positions and every triangle's plane
 /// (PlaneCoefficients::of its corners), computed once per frame, and optionally which
 /// vertices' fans are clear (fan_is_clear; null: none is taken as clear).
@@ -168,7 +182,18 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
   geom::Sign side_t[3], side_x[3];
   if (separated_by_sides(frame, t, tt, t_shared, x, xt, x_shared, side_t, side_x)) return;
   const uint8_t owned_t = topo.owned_edges[t], owned_x = topo.owned_edges[x];
+  if (!(owned_t | owned_x)) return;
   const geom::FilteredPredicates pred{frame.positions};
+  // Most pairs that get this far share no vertex and straddle each other's planes: their
+  // edges are decided together, from two or four orientations where the edge tests ask six.
+  if (t_shared == 0 && geom::strict_sides(side_t) && geom::strict_sides(side_x)) {
+    geom::Answer t_hits[3], x_hits[3];
+    if (geom::straddling_edge_hits(pred, tt, xt, side_t, side_x, t_hits, x_hits)) {
+      report_owned_edges(topo, t, owned_t, x, t_hits, sink);
+      report_owned_edges(topo, x, owned_x, t, x_hits, sink);
+      return;
+    }
+  }
   if (owned_t) test_owned_edges(pred, topo, t, tt, owned_t, t_shared, x, xt, side_t, sink);
   if (owned_x) test_owned_edges(pred, topo, x, xt, owned_x, x_shared, t, tt, side_x, sink);
 }

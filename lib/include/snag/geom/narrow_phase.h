@@ -243,6 +243,74 @@ SNAG_HD Answer is_crossing_given_sides(const P& pred, const Tri& f, const Tri& x
   return uncertain ? Answer::uncertain : Answer::no;
 }
 
+/// Whether all three sides are certain and nonzero.
+SNAG_HD_INLINE bool strict_sides(const Sign side[3]) {
+  bool strict = true;
+  for (int i = 0; i < 3; ++i) strict &= side[i] == Sign::positive || side[i] == Sign::negative;
+  return strict;
+}
+
+/// edge_hits_triangle for every edge of f against x and of x against f at once, for two
+/// triangles sharing no vertex whose corners lie strictly on both sides of the other's plane
+/// (sf, sx: certain and nonzero, not all alike). f_hits[k] answers for f's edge k (corners k,
+/// k + 1), x_hits[k] for x's. Returns false, leaving the answers unset, when a sign it needs is
+/// uncertain (edge_hits_triangle, edge by edge, then decides).
+///
+/// With the lone corners f0 and x0 as in is_crossing_given_sides, the edge f0-fi crosses x's
+/// plane at one point Ii and the edge f1-f2 does not reach it, so f0-fi hits x iff Ii lies in
+/// x's segment [J1, J2] on the line L where the planes meet (likewise for x's edges against
+/// [I1, I2]). Along the direction n_f x n_x of L, Jj - Ii has the sign of a b orient3d(f0, fi,
+/// x0, xj), where a, b are the lone corners' sides, I2 - I1 that of -a and J2 - J1 that of b
+/// (expand as in is_crossing_given_sides; the tests check these signs against the edge tests).
+/// So the ends of both segments are ordered without arithmetic, two signs say whether the
+/// segments meet (as in Guigue and Devillers' triangle test) and two more which ends lie in the
+/// other segment: two or four orient3d over two planes, where the edge tests ask six.
+template <class P>
+SNAG_HD bool straddling_edge_hits(const P& pred, const Tri& f, const Tri& x, const Sign sf[3],
+                                  const Sign sx[3], Answer f_hits[3], Answer x_hits[3]) {
+  const int fl = lone_corner(sf), xl = lone_corner(sx);
+  const int32_t f0 = f.v[fl], x0 = x.v[xl];
+  const int32_t fi[3] = {f0, f.v[(fl + 1) % 3], f.v[(fl + 2) % 3]};
+  const int32_t xj[3] = {x0, x.v[(xl + 1) % 3], x.v[(xl + 2) % 3]};
+  const bool flip = sf[fl] != sx[xl];  // a b < 0
+  // The lower and upper ends of each segment along L: I2 < I1 when a > 0, J1 < J2 when b > 0.
+  const int i_low = sf[fl] == Sign::positive ? 2 : 1, i_high = 3 - i_low;
+  const int j_low = sx[xl] == Sign::positive ? 1 : 2, j_high = 3 - j_low;
+  const auto plane_low = pred.plane(f0, fi[i_low], x0);
+  const auto plane_high = pred.plane(f0, fi[i_high], x0);
+  // sign(Jj - Ii) for Ii from `plane` (that of f0, fi, x0).
+  const auto order = [&](const auto& plane, int j) {
+    const Sign s = plane.side(xj[j]);
+    return flip ? negate(s) : s;
+  };
+  Answer low_i = Answer::no, high_i = Answer::no, low_j = Answer::no, high_j = Answer::no;
+  const Sign above_low = order(plane_low, j_high);  // J_high - I_low
+  if (above_low == Sign::uncertain) return false;
+  if (above_low != Sign::negative) {
+    const Sign below_high = order(plane_high, j_low);  // J_low - I_high
+    if (below_high == Sign::uncertain) return false;
+    if (below_high != Sign::positive) {
+      // The segments meet: I_low <= J_high and J_low <= I_high. An end lies in the other
+      // segment when it is not past the other's end on its own side.
+      const Sign lows = order(plane_low, j_low);     // J_low - I_low
+      const Sign highs = order(plane_high, j_high);  // J_high - I_high
+      if (lows == Sign::uncertain || highs == Sign::uncertain) return false;
+      low_i = lows != Sign::positive ? Answer::yes : Answer::no;
+      high_i = highs != Sign::negative ? Answer::yes : Answer::no;
+      low_j = lows != Sign::negative ? Answer::yes : Answer::no;
+      high_j = highs != Sign::positive ? Answer::yes : Answer::no;
+    }
+  }
+  // Edge k joins corners k and k + 1: f0-f1 is edge fl, f2-f0 edge fl + 2, f1-f2 misses.
+  f_hits[fl] = i_low == 1 ? low_i : high_i;
+  f_hits[(fl + 2) % 3] = i_low == 2 ? low_i : high_i;
+  f_hits[(fl + 1) % 3] = Answer::no;
+  x_hits[xl] = j_low == 1 ? low_j : high_j;
+  x_hits[(xl + 2) % 3] = j_low == 2 ? low_j : high_j;
+  x_hits[(xl + 1) % 3] = Answer::no;
+  return true;
+}
+
 /// is_crossing with the sides of f's corners w.r.t. x's plane (sf) and of x's w.r.t. f's (sx)
 /// computed here (see is_crossing_given_sides for callers that have them already).
 template <class P>
