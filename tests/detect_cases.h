@@ -1,5 +1,5 @@
 // Test meshes shared by the lib and cuda tests: the hand-built cases with their exact expected
-// pairs and kinds, random lattice soups, folded grids, integer affine maps, and the brute-force
+// pairs and kinds, random and lattice soups, folded grids, integer affine maps, and the brute-force
 // O(n^2) reference finder over exact integer predicates.
 #pragma once
 
@@ -168,6 +168,21 @@ inline SmallMesh lattice_soup(int32_t triangles, int32_t vertices, int range, ui
   for (int32_t t = 0; t < triangles; ++t)
     mesh.triangles.push_back({{pick(rng), pick(rng), pick(rng)}});
   return mesh;
+}
+
+/// n triangles with three vertices of their own each: centres uniform in a 10-unit cube, corners
+/// within `size` of the centre in each coordinate (non-integer coordinates: the filter decides).
+inline SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> where(0.0, 10.0), offset(-size, size);
+  SmallMesh soup;
+  for (int32_t t = 0; t < n; ++t) {
+    const geom::Vec3d c{where(rng), where(rng), where(rng)};
+    for (int k = 0; k < 3; ++k)
+      soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
+    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+  }
+  return soup;
 }
 
 /// A grid of w x h cells, vertex (i, j) at `at(i, j)`, each cell split along the diagonal

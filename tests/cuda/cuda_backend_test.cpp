@@ -83,20 +83,6 @@ detect::FrameResult check_on_gpu(const SmallMesh& mesh) {
   return checker.check(mesh.positions);
 }
 
-/// A soup of n random triangles in a 10-unit cube (non-integer coordinates: the filter decides).
-SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> where(0.0, 10.0), offset(-size, size);
-  SmallMesh soup;
-  for (int32_t t = 0; t < n; ++t) {
-    const geom::Vec3d c{where(rng), where(rng), where(rng)};
-    for (int k = 0; k < 3; ++k)
-      soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
-    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
-  }
-  return soup;
-}
-
 TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
   SNAG_REQUIRE_GPU();
   auto gpu = gpu_backend();
@@ -137,8 +123,8 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
   // the last block's first warp takes the blocks' roots (2 to 256 of them: one a lane up to
   // 8,192 leaves, two, four, then eight from 32,769), and past 2^16 leaves the whole block
   // merges the widest levels above them first (cuda/src/device_tree.cu).
-  for (int32_t n : {1, 2, 3, 5, 20, 40, 77, 128, 129, 257, 512, 513, 1000, 1500, 3000, 5000, 10000,
-                    20000, 33333, 70000, 300001}) {
+  for (int32_t n : {1,   2,    3,    5,    20,   40,    77,    128,   129,   257,   512,
+                    513, 1000, 1500, 3000, 5000, 10000, 20000, 33333, 70000, 300001}) {
     SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
     const detect::Topology topology =
         detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
@@ -449,9 +435,12 @@ TEST(CudaDetect, FanClearedNeighboursLeftOutCountAsOnTheCpu) {
   SmallMesh degenerate = sheet(4);
   degenerate.positions[degenerate.triangles[500].v[0]] =
       degenerate.positions[degenerate.triangles[500].v[1]];
-  const std::vector<std::pair<std::string, SmallMesh>> frames = {
-      {"flat", flat},           {"ripples 4", sheet(4)}, {"zero-area faces", degenerate},
-      {"ripples 12", sheet(12)}, {"ripples 40", sheet(40)}, {"folded", folded_grid(w, h)}};
+  const std::vector<std::pair<std::string, SmallMesh>> frames = {{"flat", flat},
+                                                                 {"ripples 4", sheet(4)},
+                                                                 {"zero-area faces", degenerate},
+                                                                 {"ripples 12", sheet(12)},
+                                                                 {"ripples 40", sheet(40)},
+                                                                 {"folded", folded_grid(w, h)}};
   for (size_t f = 0; f < frames.size(); ++f) {
     const auto& [what, mesh] = frames[f];
     const Filtered c = filtered(*cpu, mesh.positions, f == 0);

@@ -6,6 +6,7 @@
 #include <random>
 #include <set>
 
+#include "detect_cases.h"
 #include "snag/bvh/complete_tree.h"
 #include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
@@ -53,23 +54,10 @@ TEST(CompleteTree, LeafPositionMappingAndRangesForEveryNUpTo5000) {
   }
 }
 
-struct Soup {
-  std::vector<geom::Vec3d> positions;
-  std::vector<geom::Tri> triangles;
-  mesh::MeshView view() const { return mesh::view_of(positions, triangles); }
-};
-
-Soup random_soup(int32_t count, uint32_t seed, double size) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> where(0.0, 10.0), offset(-size, size);
-  Soup soup;
-  for (int32_t t = 0; t < count; ++t) {
-    const geom::Vec3d c{where(rng), where(rng), where(rng)};
-    for (int k = 0; k < 3; ++k)
-      soup.positions.push_back(c + geom::Vec3d{offset(rng), offset(rng), offset(rng)});
-    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
-  }
-  return soup;
+using Soup = test::SmallMesh;
+using test::random_soup;
+mesh::MeshView soup_view(const Soup& soup) {
+  return mesh::view_of(soup.positions, soup.triangles);
 }
 
 void expect_boxes_nest(const Tree& tree, const Soup& soup) {
@@ -96,7 +84,7 @@ TEST(Tree, EveryTriangleInExactlyOneLeafAndBoxesNestAfterBuildAndRefit) {
     SCOPED_TRACE("n=" + std::to_string(n) + " seed=" + std::to_string(seed));
     Soup soup = random_soup(n, seed, 0.3);
     Tree tree;
-    tree.build(soup.view(), 2);
+    tree.build(soup_view(soup), 2);
     std::vector<int32_t> sorted = tree.triangle_at();
     std::sort(sorted.begin(), sorted.end());
     for (int32_t t = 0; t < n; ++t) ASSERT_EQ(sorted[t], t);
@@ -105,7 +93,7 @@ TEST(Tree, EveryTriangleInExactlyOneLeafAndBoxesNestAfterBuildAndRefit) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> move(-1.0, 1.0);
     for (auto& p : soup.positions) p = p + geom::Vec3d{move(rng), move(rng), move(rng)};
-    tree.refit(soup.view(), 2);
+    tree.refit(soup_view(soup), 2);
     expect_boxes_nest(tree, soup);
   }
 }
@@ -113,9 +101,9 @@ TEST(Tree, EveryTriangleInExactlyOneLeafAndBoxesNestAfterBuildAndRefit) {
 TEST(Tree, BuildIsTheSameForEveryThreadCount) {
   Soup soup = random_soup(3000, 7, 0.2);
   Tree one, two, four;
-  one.build(soup.view(), 1);
-  two.build(soup.view(), 2);
-  four.build(soup.view(), 4);
+  one.build(soup_view(soup), 1);
+  two.build(soup_view(soup), 2);
+  four.build(soup_view(soup), 4);
   EXPECT_EQ(one.triangle_at(), two.triangle_at());
   EXPECT_EQ(one.triangle_at(), four.triangle_at());
 }
@@ -125,7 +113,7 @@ TEST(Tree, QualityIsTheSameBitsForEveryThreadCountAndTheSumOfHalfAreas) {
     SCOPED_TRACE("n=" + std::to_string(n));
     Soup soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.2);
     Tree tree;
-    tree.build(soup.view(), 2);
+    tree.build(soup_view(soup), 2);
     const double one = tree.quality(1);
     EXPECT_EQ(one, tree.quality(2));
     EXPECT_EQ(one, tree.quality(4));
@@ -154,7 +142,7 @@ TEST(Tree, BuildSplitsEachSegmentAlongTheLongestAxis) {
     soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
   }
   Tree tree;
-  tree.build(soup.view(), 2);
+  tree.build(soup_view(soup), 2);
   for (int32_t p = 1; p < n; ++p)
     ASSERT_LT(soup.positions[3 * tree.triangle_at()[p - 1]].x,
               soup.positions[3 * tree.triangle_at()[p]].x);
@@ -197,7 +185,7 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
                    " seed=" + std::to_string(seed));
       Soup soup = random_soup(n, seed, size);
       Tree tree;
-      tree.build(soup.view(), 2);
+      tree.build(soup_view(soup), 2);
       const TreeView view = tree.view();
       const PairMultiset visited = per_leaf_pairs(view);
       PairMultiset expected;
@@ -247,7 +235,7 @@ TEST(Traversal, WalksSplitAtAnyLevelVisitTheSamePairsOnce) {
     for (double size : {0.2, 1.0, 4.0}) {
       Soup soup = random_soup(n, static_cast<uint32_t>(n * 17 + size * 3), size);
       Tree tree;
-      tree.build(soup.view(), 2);
+      tree.build(soup_view(soup), 2);
       const TreeView view = tree.view();
       const PairMultiset expected = per_leaf_pairs(view);
       for (int32_t cut = 0; cut <= view.shape.depth; ++cut) {
@@ -292,7 +280,7 @@ TEST(Traversal, ReadAheadWalkVisitsWalkSubtreesLeavesInTheSameOrder) {
     for (double size : {0.05, 0.3, 1.0, 4.0}) {
       Soup soup = random_soup(n, static_cast<uint32_t>(n * 13 + size * 5), size);
       Tree tree;
-      tree.build(soup.view(), 1);
+      tree.build(soup_view(soup), 1);
       const TreeView view = tree.view();
       std::uniform_int_distribution<int32_t> node_of(0, view.shape.node_count() - 1);
       std::uniform_real_distribution<float> coordinate(-1.0f, 11.0f), extent(0.0f, 3.0f);
@@ -342,7 +330,7 @@ TEST(Traversal, GroupedWalkIgnoresAbsentLanesEvenForBoxesBeyondTheFloatRange) {
       soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
     }
     Tree tree;
-    tree.build(soup.view(), 1);
+    tree.build(soup_view(soup), 1);
     const TreeView view = tree.view();
     const PairMultiset per_leaf = per_leaf_pairs(view);
     for (const PairMultiset& grouped : {grouped_pairs<4>(view), grouped_pairs<8>(view)}) {
@@ -394,7 +382,7 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
                    " seed=" + std::to_string(seed));
       Soup soup = random_soup(n, seed, size);
       Tree tree;
-      tree.build(soup.view(), 2);
+      tree.build(soup_view(soup), 2);
       const TreeView view = tree.view();
       const PairMultiset per_leaf = per_leaf_pairs(view);
       ASSERT_EQ(grouped_pairs<4>(view), per_leaf);

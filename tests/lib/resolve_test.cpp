@@ -9,12 +9,16 @@
 #include <random>
 #include <vector>
 
+#include "detect_cases.h"
 #include "snag/detect/resolve.h"
 #include "snag/detect/topology.h"
 #include "snag/geom/predicates.h"
 
 namespace snag::detect {
 namespace {
+
+using test::random_soup;
+using test::SmallMesh;
 
 /// The most threads of any team a CountingPredicates was called from.
 std::atomic<int> most_threads{0};
@@ -46,27 +50,9 @@ struct CountingPredicates {
   }
 };
 
-struct Soup {
-  std::vector<geom::Vec3d> positions;
-  std::vector<geom::Tri> triangles;
-};
-
-/// n random triangles in a unit cube, three vertices of their own each.
-Soup random_soup(int32_t n, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> coordinate(0.0, 1.0);
-  Soup soup;
-  for (int32_t t = 0; t < n; ++t) {
-    for (int k = 0; k < 3; ++k)
-      soup.positions.push_back({coordinate(rng), coordinate(rng), coordinate(rng)});
-    soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
-  }
-  return soup;
-}
-
 TEST(Resolve, LoopsRunOnTheContextsThreadsAndGiveTheProvidersAnswers) {
   const int cores = omp_get_max_threads();
-  const Soup soup = random_soup(6000, 11);
+  const SmallMesh soup = random_soup(6000, 11, 0.5);
   const Topology topology =
       make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
   const geom::RoundedPredicates rounded{soup.positions.data()};
