@@ -341,6 +341,92 @@ std::span<const T> slice(const std::vector<T>& all, const std::vector<int32_t>& 
                                          static_cast<size_t>(begin[object + 1] - begin[object]));
 }
 
+/// The vertex each vertex of a topology's first frame counts as for adjacency
+/// (mesh::welded_triangles), per object with its own --weld tolerance; empty when no vertex is
+/// welded to another. On the sequence's first frame (`first`) it counts the welded vertices
+/// into `inputs` and warns of exactly coincident vertices in objects that weld nothing.
+std::vector<int32_t> adjacency_representatives(
+    const scene::ResolvedScene& scene, const scene::SceneFrame& frame, bool first,
+    report::Inputs& inputs, const std::function<void(const std::string&)>& warn) {
+  const detect::PartLayout& layout = frame.layout;
+  std::vector<int32_t> representative;
+  for (int32_t o = 0; o < static_cast<int32_t>(scene.objects.size()); ++o) {
+    const std::span<const geom::Vec3d> positions =
+        slice(frame.mesh.positions, layout.vertex_begin, o);
+    const std::optional<double>& weld = scene.objects[o].spec.weld;
+    if (weld) {
+      const std::vector<int32_t> local = mesh::weld_representatives(positions, *weld);
+      int64_t welded = 0;
+      for (size_t v = 0; v < local.size(); ++v) {
+        welded += local[v] != static_cast<int32_t>(v);
+        representative.push_back(local[v] + layout.vertex_begin[o]);
+      }
+      if (first) inputs.welded_vertices += welded;
+      continue;
+    }
+    for (int32_t v = layout.vertex_begin[o]; v < layout.vertex_begin[o + 1]; ++v)
+      representative.push_back(v);
+    if (!first) continue;
+    const int64_t coincident = mesh::count_coincident_vertices(positions);
+    inputs.coincident_vertices += coincident;
+    if (coincident > 0)
+      warn(frame.files[o] + ": " + std::to_string(coincident) +
+           (coincident == 1 ? " vertex coincides" : " vertices coincide") +
+           " exactly with another vertex but are separate vertices; unwelded seams are "
+           "reported as intersections (use --weld TOL)");
+  }
+  for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
+    if (representative[v] != v) return representative;
+  return {};
+}
+
+/// A topology's penetration meters: one per closed obstacle that a cloth is checked against,
+/// with those cloths, over the frame's positions. Closedness is the weld's (`welded`: the
+/// scene's triangles after mesh::welded_triangles), and an obstacle whose faces point inwards
+/// is measured flipped. With `record_closed` (a scene report's first frame), each such
+/// obstacle's closedness goes into `inputs`.
+std::vector<Meter> make_meters(const scene::ResolvedScene& scene, const scene::SceneFrame& frame,
+                               std::span<const geom::Tri> welded, bool record_closed,
+                               report::Inputs& inputs, int workers) {
+  const detect::PartLayout& layout = frame.layout;
+  std::vector<Meter> meters;
+  for (const detect::PartCheck& c : scene.checks) {
+    if (c.self()) continue;
+    const auto role = [&](int32_t o) { return scene.objects[o].spec.role; };
+    if (role(c.a) == role(c.b)) continue;
+    const int32_t obstacle = role(c.a) == scene::Role::obstacle ? c.a : c.b;
+    const int32_t cloth = obstacle == c.a ? c.b : c.a;
+    auto at = std::find_if(meters.begin(), meters.end(),
+                           [&](const Meter& m) { return m.obstacle == obstacle; });
+    if (at == meters.end()) {
+      // Closedness as the weld sees it: a body stored as a triangle soup can be welded.
+      const std::vector<geom::Tri> local = local_triangles(welded, layout, obstacle);
+      const int32_t vertices = layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
+      const std::optional<std::string> why = why_obstacle_not_closed(
+          frame, local, obstacle, scene.objects[obstacle].spec.group.has_value());
+      if (record_closed)
+        inputs.objects[static_cast<size_t>(obstacle)].closed = why ? *why : "closed";
+      if (why) continue;
+      // A closed obstacle whose faces point inwards would measure its complement: its inside is
+      // the side of negative enclosed volume, so it is measured flipped.
+      const std::span<const geom::Vec3d> positions =
+          slice(frame.mesh.positions, layout.vertex_begin, obstacle);
+      auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
+      meter->update_positions(positions, workers);
+      if (meter->enclosed_volume() < 0) {
+        std::vector<geom::Tri> flipped = local;
+        for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
+        meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
+        meter->update_positions(positions, workers);
+      }
+      meters.push_back({obstacle, std::move(meter), {}, true});
+      at = meters.end() - 1;
+    }
+    at->cloths.push_back({cloth, {}});
+  }
+  return meters;
+}
+
 /// Whether an ignore rule of either object leaves the pair of (group a, group b) out.
 bool ignored(const scene::ResolvedScene& scene, int32_t object_a, const std::string& group_a,
              int32_t object_b, const std::string& group_b) {
@@ -595,81 +681,11 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         // Welding is decided once per topology, on its first frame, per object with its own
         // tolerance: seams stay closed while the cloth moves, and a weld that changed from
         // frame to frame would rebuild the tree.
-        std::vector<int32_t> representative;
-        for (int32_t o = 0; o < object_count; ++o) {
-          const std::span<const geom::Vec3d> positions =
-              slice(mesh.positions, layout.vertex_begin, o);
-          const std::optional<double>& weld = scene.objects[o].spec.weld;
-          const std::string& file = scene_frame.files[o];
-          if (weld) {
-            const std::vector<int32_t> local = mesh::weld_representatives(positions, *weld);
-            int64_t welded = 0;
-            for (size_t v = 0; v < local.size(); ++v) {
-              welded += local[v] != static_cast<int32_t>(v);
-              representative.push_back(local[v] + layout.vertex_begin[o]);
-            }
-            if (i == 0) inputs.welded_vertices += welded;
-          } else {
-            for (int32_t v = layout.vertex_begin[o]; v < layout.vertex_begin[o + 1]; ++v)
-              representative.push_back(v);
-            if (i > 0) continue;
-            const int64_t coincident = mesh::count_coincident_vertices(positions);
-            inputs.coincident_vertices += coincident;
-            if (coincident > 0)
-              warn(file + ": " + std::to_string(coincident) +
-                   (coincident == 1 ? " vertex coincides" : " vertices coincide") +
-                   " exactly with another vertex but are separate vertices; unwelded seams are "
-                   "reported as intersections (use --weld TOL)");
-          }
-        }
-        bool any_weld = false;
-        for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
-          any_weld = any_weld || representative[v] != v;
-        if (!any_weld) representative.clear();
-        const std::vector<geom::Tri> welded =
-            mesh::welded_triangles(mesh.triangles, representative);
+        const std::vector<geom::Tri> welded = mesh::welded_triangles(
+            mesh.triangles, adjacency_representatives(scene, scene_frame, i == 0, inputs, warn));
         checker.set_scene(welded, static_cast<int32_t>(mesh.positions.size()), layout,
                           scene.checks);
-
-        // Penetration into each closed obstacle a cloth is checked against.
-        meters.clear();
-        for (const detect::PartCheck& c : scene.checks) {
-          if (c.self()) continue;
-          const auto role = [&](int32_t o) { return scene.objects[o].spec.role; };
-          if (role(c.a) == role(c.b)) continue;
-          const int32_t obstacle = role(c.a) == scene::Role::obstacle ? c.a : c.b;
-          const int32_t cloth = obstacle == c.a ? c.b : c.a;
-          auto at = std::find_if(meters.begin(), meters.end(),
-                                 [&](const Meter& m) { return m.obstacle == obstacle; });
-          if (at == meters.end()) {
-            // Closedness as the weld sees it: a body stored as a triangle soup can be welded.
-            const std::vector<geom::Tri> local = local_triangles(welded, layout, obstacle);
-            const int32_t vertices =
-                layout.vertex_begin[obstacle + 1] - layout.vertex_begin[obstacle];
-            const std::optional<std::string> why = why_obstacle_not_closed(
-                scene_frame, local, obstacle, scene.objects[obstacle].spec.group.has_value());
-            if (i == 0 && scene_report) {
-              report::ObjectInput& input = inputs.objects[static_cast<size_t>(obstacle)];
-              input.closed = why ? *why : "closed";
-            }
-            if (why) continue;
-            // A closed obstacle whose faces point inwards would measure its complement: its
-            // inside is the side of negative enclosed volume, so it is measured flipped.
-            const std::span<const geom::Vec3d> positions =
-                slice(mesh.positions, layout.vertex_begin, obstacle);
-            auto meter = std::make_unique<measure::PenetrationMeter>(local, vertices);
-            meter->update_positions(positions, workers);
-            if (meter->enclosed_volume() < 0) {
-              std::vector<geom::Tri> flipped = local;
-              for (geom::Tri& t : flipped) std::swap(t.v[1], t.v[2]);
-              meter = std::make_unique<measure::PenetrationMeter>(flipped, vertices);
-              meter->update_positions(positions, workers);
-            }
-            meters.push_back({obstacle, std::move(meter), {}, true});
-            at = meters.end() - 1;
-          }
-          at->cloths.push_back({cloth, {}});
-        }
+        meters = make_meters(scene, scene_frame, welded, i == 0 && scene_report, inputs, workers);
       }
       const double read_seconds =
           current->frame->read_seconds + current->comparing_seconds + seconds_since(read_started);
