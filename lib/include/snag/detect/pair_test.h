@@ -98,18 +98,18 @@ SNAG_HD_INLINE void test_owned_edges(const P& pred, const TopologyView& topo, in
   });
 }
 
-/// Reports the answers of straddling_edge_hits for the edges triangle `t` represents (t shares
-/// no vertex with x, so every one of them is tested), in test_owned_edges' order.
+/// Reports the answers of straddling_edge_hits (`hits`, by edge of t, none uncertain) for the
+/// edges triangle `t` tests against `x`, as test_owned_edges would report them.
 template <class Sink>
 SNAG_HD_INLINE void report_owned_edges(const TopologyView& topo, int32_t t, uint8_t owned,
-                                       int32_t x, const geom::Answer hits[3], Sink& sink) {
-  for (int k = 0; k < 3; ++k) {
-    if (!(owned & (1u << k))) continue;
+                                       uint32_t shared, int32_t x, const geom::Answer hits[3],
+                                       Sink& sink) {
+  for_each_tested_edge(topo, t, owned, shared, [&](int k, int32_t edge) {
     if (hits[k] == geom::Answer::yes)
-      sink.hit(topo.triangle_edges[t][k], x);
+      sink.hit(edge, x);
     else
       sink.miss();
-  }
+  });
 }
 
 /// What the pair tests read of one frame: the positions and every triangle's plane
@@ -189,8 +189,8 @@ SNAG_HD void test_pair_given_shared(const FrameView& frame, const TopologyView& 
   if (t_shared == 0 && geom::strict_sides(side_t) && geom::strict_sides(side_x)) {
     geom::Answer t_hits[3], x_hits[3];
     if (geom::straddling_edge_hits(pred, tt, xt, side_t, side_x, t_hits, x_hits)) {
-      report_owned_edges(topo, t, owned_t, x, t_hits, sink);
-      report_owned_edges(topo, x, owned_x, t, x_hits, sink);
+      report_owned_edges(topo, t, owned_t, t_shared, x, t_hits, sink);
+      report_owned_edges(topo, x, owned_x, x_shared, t, x_hits, sink);
       return;
     }
   }
