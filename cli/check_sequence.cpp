@@ -350,6 +350,7 @@ std::vector<int32_t> adjacency_representatives(
     report::Inputs& inputs, const std::function<void(const std::string&)>& warn) {
   const detect::PartLayout& layout = frame.layout;
   std::vector<int32_t> representative;
+  int64_t welded_in_all = 0;
   for (int32_t o = 0; o < static_cast<int32_t>(scene.objects.size()); ++o) {
     const std::span<const geom::Vec3d> positions =
         slice(frame.mesh.positions, layout.vertex_begin, o);
@@ -361,6 +362,7 @@ std::vector<int32_t> adjacency_representatives(
         welded += local[v] != static_cast<int32_t>(v);
         representative.push_back(local[v] + layout.vertex_begin[o]);
       }
+      welded_in_all += welded;
       if (first) inputs.welded_vertices += welded;
       continue;
     }
@@ -375,9 +377,8 @@ std::vector<int32_t> adjacency_representatives(
            " exactly with another vertex but are separate vertices; unwelded seams are "
            "reported as intersections (use --weld TOL)");
   }
-  for (int32_t v = 0; v < static_cast<int32_t>(representative.size()); ++v)
-    if (representative[v] != v) return representative;
-  return {};
+  if (welded_in_all == 0) representative.clear();
+  return representative;
 }
 
 /// A topology's penetration meters: one per closed obstacle that a cloth is checked against,
