@@ -52,7 +52,11 @@ struct CountingPredicates {
 
 TEST(Resolve, LoopsRunOnTheContextsThreadsAndGiveTheProvidersAnswers) {
   const int cores = omp_get_max_threads();
-  const SmallMesh soup = random_soup(6000, 11, 0.5);
+  // Corners spread far beyond the 10-unit cube of the centres: triangles as large as the
+  // region, so that the arbitrary pairs below often meet (186 of the 2,000 edge tests hit and
+  // 552 pairs are crossings, as many as corners anywhere in a cube gave; with small triangles
+  // every answer would be `no`).
+  const SmallMesh soup = random_soup(6000, 11, 50.0);
   const Topology topology =
       make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
   const geom::RoundedPredicates rounded{soup.positions.data()};
@@ -92,6 +96,8 @@ TEST(Resolve, LoopsRunOnTheContextsThreadsAndGiveTheProvidersAnswers) {
                                                       topology.triangles[pairs[i].b]);
       ASSERT_EQ(kinds[i] == PairKind::crossing, crossing == geom::Answer::yes) << "pair " << i;
     }
+    EXPECT_GT(std::count(hit.begin(), hit.end(), 1), 0);  // the answers are not all `no`
+    EXPECT_GT(std::count(kinds.begin(), kinds.end(), PairKind::crossing), 0);
     EXPECT_EQ(std::count(degenerate.begin(), degenerate.end(), 1), 0);
   }
   // Without a thread count (0), OpenMP's default: every core may take part.
