@@ -30,6 +30,12 @@ def stripped(value):
     return value
 
 
+def first_unequal(xs, ys):
+    """Index of the first element where two lists differ (the shorter one's length when one
+    is the other's start)."""
+    return next((i for i, (x, y) in enumerate(zip(xs, ys)) if x != y), min(len(xs), len(ys)))
+
+
 def first_difference(a, b, path='report.json'):
     if type(a) is not type(b):
         return f'{path}: {a!r} against {b!r}'
@@ -70,13 +76,10 @@ def main():
     difference = None
     if pairs_a != pairs_b:
         lines_a, lines_b = pairs_a.splitlines(), pairs_b.splitlines()
-        at = next((i for i, (x, y) in enumerate(zip(lines_a, lines_b)) if x != y),
-                  min(len(lines_a), len(lines_b)))
+        at = first_unequal(lines_a, lines_b)
         difference = f'pairs.csv line {at + 1} ({len(lines_a)} lines against {len(lines_b)})'
     elif rows_a != rows_b:
-        at = next((i for i, (x, y) in enumerate(zip(rows_a, rows_b)) if x != y),
-                  min(len(rows_a), len(rows_b)))
-        difference = f'frames.csv row {at + 1}'
+        difference = f'frames.csv row {first_unequal(rows_a, rows_b) + 1}'
     else:
         difference = first_difference(json_a, json_b)
     if difference:
