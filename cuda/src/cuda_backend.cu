@@ -59,7 +59,7 @@ class CudaBackendImpl final : public CudaBackend {
     upload_stream_ = std::make_unique<Stream>();
     side_stream_ = std::make_unique<Stream>();
     counters_.reserve(1);
-    counters_host_.reserve(1);
+    for (auto& counters : counters_host_) counters.reserve(1);
     scan_counters_.reserve(1);
     scan_counts_host_.reserve(1);
     SNAG_CUDA_CHECK(
@@ -100,8 +100,14 @@ class CudaBackendImpl final : public CudaBackend {
   double stop_timer() override { return span_timer_.stop(stream()); }
 
   void set_topology(const detect::Topology& topology) override {
-    drop_staged_positions();  // its buffers may be reallocated below
+    // Work queued ahead, or cut short by an exception, may still use buffers reallocated below.
+    stream_->synchronize();
+    side_stream_->synchronize();
+    drop_staged_positions();
     speculation_ = {};
+    ahead_ = {};
+    scanned_ = false;
+    release_recorded_ = false;
     last_detect_ = {};
     topology_ = &topology;
     const cudaStream_t s = stream();
@@ -130,10 +136,12 @@ class CudaBackendImpl final : public CudaBackend {
     flagged_.clear();
     scan_degenerate_host_.reserve(std::max<size_t>(n, 1));
     scan_uncertain_host_.reserve(std::max<size_t>(n, 1));
-    host_pairs_.reserve(kFinishLimit);
-    host_uncertain_.reserve(kFinishLimit);
-    host_results_ = {mapped(host_pairs_.data()), mapped(host_uncertain_.data()),
-                     mapped(counters_host_.data())};
+    for (int set = 0; set < 2; ++set) {
+      host_pairs_[set].reserve(kFinishLimit);
+      host_uncertain_[set].reserve(kFinishLimit);
+      host_results_[set] = {mapped(host_pairs_[set].data()), mapped(host_uncertain_[set].data()),
+                            mapped(counters_host_[set].data())};
+    }
     planes_.reserve(std::max<size_t>(n, 1));
     for (int slot = 0; slot < 2; ++slot) {
       positions_[slot].reserve(std::max<int32_t>(d.vertex_count, 1));
@@ -174,6 +182,7 @@ class CudaBackendImpl final : public CudaBackend {
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
     const int slot = 1 - positions_slot_;
+    scanned_ = false;
     if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_ &&
         same_moved(moved, staged_moved_)) {
       // Copied across while the previous frame was checked: the stream only waits for the copy
@@ -187,6 +196,7 @@ class CudaBackendImpl final : public CudaBackend {
       positions_slot_ = slot;
     } else {
       drop_staged_positions();
+      release_recorded_ = false;  // it was for the slot the staged frame would have left
       const std::vector<uint64_t> versions = next_versions(moved);
       for (size_t p = 0; p < part_.size(); ++p) part_[p].version = versions[p];
       if (!on_resident_ && slot_version_[positions_slot_] == versions) {
@@ -208,7 +218,8 @@ class CudaBackendImpl final : public CudaBackend {
 
   /// The next frame's positions go into the slot the current frame does not use, on their own
   /// stream, alongside the current frame's kernels. That slot held the previous frame, whose
-  /// work is all queued before this point on the main stream: the transfer waits for it. The
+  /// work is all queued before this point on the main stream: the transfer waits for it (for
+  /// the point where it ended, when the current frame's work was queued ahead after it). The
   /// host's copy into pinned memory (~40 us for 36K triangles) waits until the current frame's
   /// work is queued (copy_staged_positions, from the scan's wait, else from detect's or the next
   /// set): done here, a checker's frame began with it while the device had nothing to do. Parts
@@ -222,7 +233,8 @@ class CudaBackendImpl final : public CudaBackend {
     if (slot_version_[positions_slot_] == versions) return;  // the next frame is this one
     const int slot = 1 - positions_slot_;
     pinned_copied_[slot].synchronize();
-    slot_released_.record(stream());
+    if (!release_recorded_) slot_released_.record(stream());
+    release_recorded_ = false;
     slot_released_.wait_on(upload_stream_->get());
     staged_ = true;
     staged_copy_pending_ = true;
@@ -252,64 +264,39 @@ class CudaBackendImpl final : public CudaBackend {
         resident_.data() + static_cast<size_t>(index) * static_cast<size_t>(topo_.vertex_count);
     for (PartState& part : part_) part.version = ++versions_issued_;
     on_resident_ = true;
+    release_recorded_ = false;
   }
 
   /// The scan of `parts`, and ahead of the refit_part() and part_quality() calls that follow it
   /// in a checker's frame: the refit and the quality of every built tree that does not fit the
   /// current positions, queued before the scan's one wait (refit_part() and part_quality() then
-  /// find them done). A build in between makes them moot, not wrong.
-  ///
-  /// The refits and the detect queued behind them (speculate_detect) go on the main stream:
-  /// the walks need the refit's boxes and planes, not the scan or the quality, which go on the
-  /// side stream, after the frame's positions and the refits respectively, so that the walks
-  /// do not wait for them. They are queued last, once the host has queued the main stream's
-  /// work, and the host's one wait here is for them alone.
+  /// find them done). A build in between makes them moot, not wrong. All of it, and the detect,
+  /// may have been queued already at the end of the previous frame's detect (queue_ahead); then
+  /// the scan only waits.
   detect::DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) override {
     require_topology();
     detect::DegeneracyScan scan;
     if (topo_.triangle_count == 0) return scan;
-    const cudaStream_t s = stream(), side = side_stream_->get();
-    timer_.start(s);  // also what the side stream waits for: the frame's positions
-    std::vector<int32_t> ahead;
-    for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
-      if (part_[p].tree_built && part_[p].tree_version != part_[p].version && part_size(p) > 0)
-        ahead.push_back(p);
-    for (int32_t p : ahead) queue_refit(p, /*timed=*/false);  // its time is the scan's
-    refits_queued_.record(s);
-    speculate_detect();
-
-    SNAG_CUDA_CHECK(cudaStreamWaitEvent(side, timer_.start_event(), 0));
-    // One launch per part; the last publishes the counts into host memory (none: no launch,
-    // and the counts stay zero).
-    size_t last_scanned = parts.size();
-    for (size_t i = 0; i < parts.size(); ++i)
-      if (part_size(parts[i]) > 0) last_scanned = i;
-    ScanCounts* const counts = scan_counts_host_.data();
-    *counts = {};
-    // A scan cut short (an exception between its launches and its counts read) or whose counts
-    // were wrong may have left counts in the counters, which only a whole scan zeroes: cleared
-    // first.
-    if (scan_pending_)
-      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
-    scan_pending_ = true;
-    for (size_t i = 0; i < parts.size(); ++i)
-      if (part_size(parts[i]) > 0)
-        launch_scan_degenerate(current_positions_, topo_.triangles.data(), part_begin(parts[i]),
-                               part_size(parts[i]), mapped(scan_degenerate_host_.data()),
-                               mapped(scan_uncertain_host_.data()), topo_.triangle_count,
-                               scan_counters_.data(), i == last_scanned ? mapped(counts) : nullptr,
-                               side);
-    if (!ahead.empty()) refits_queued_.wait_on(side);
-    for (int32_t p : ahead) trees_[p]->queue_quality(side);
-    timer_.stop_async(side);
+    scanned_ = true;
+    const FrameView view = current_view();
+    const bool queued_ahead = ahead_.queued && ahead_.positions == view.positions &&
+                              ahead_.versions == view.versions &&
+                              ahead_.tree_changes == tree_changes_ &&
+                              std::ranges::equal(ahead_.parts, parts);
+    // Work queued ahead for another frame than this one still writes the scan's buffers.
+    if (ahead_.queued && !queued_ahead) side_stream_->synchronize();
+    ahead_.queued = false;
+    const std::vector<int32_t> refit =
+        queued_ahead ? std::move(ahead_.refit) : queue_frame(parts, view, timer_);
+    EventTimer& timer = queued_ahead ? ahead_timer_ : timer_;
     copy_staged_positions();  // the next frame's, while the device works on this one
-    times_.scan = timer_.elapsed();  // the wait: scan, refits and qualities done
+    times_.scan = timer.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
-    for (int32_t p : ahead) {
+    for (int32_t p : refit) {
       part_[p].quality = trees_[p]->queued_quality();
       part_[p].quality_ready = true;
     }
-    const ScanCounts c = *counts;
+    const ScanCounts c = *scan_counts_host_.data();
     int64_t scanned = 0;
     for (int32_t p : parts) scanned += part_size(p);
     if (c.degenerate + c.uncertain > static_cast<unsigned long long>(scanned)) {
@@ -332,7 +319,7 @@ class CudaBackendImpl final : public CudaBackend {
   void build_part(int32_t p) override {
     require_topology();
     PartState& part = part_[p];
-    ++builds_;  // a detect queued ahead read the tree this replaces
+    ++tree_changes_;  // a detect queued ahead read the tree this replaces
     part.tree_built = true;
     part.tree_version = part.version;
     part.planes_version = part.version;
@@ -361,12 +348,14 @@ class CudaBackendImpl final : public CudaBackend {
       times_.refit = 0;
       return;
     }
-    queue_refit(p, /*timed=*/true);
+    queue_refit(p, /*timed=*/true, current_view());
   }
 
   double part_quality(int32_t p) override {
     require_topology();
     PartState& part = part_[p];
+    // A tree refit ahead to the staged frame (queue_ahead) is refit back to this one first.
+    if (needs_refit(p, current_view())) queue_refit(p, /*timed=*/true, current_view());
     if (part.quality_ready) return part.quality;
     timer_.start(stream());
     trees_[p]->queue_quality(stream());
@@ -422,11 +411,20 @@ class CudaBackendImpl final : public CudaBackend {
   int32_t part_size(int32_t p) const {
     return topology_->layout.triangle_begin[p + 1] - topology_->layout.triangle_begin[p];
   }
-  /// Part p's triangles over the whole frame's positions: its tree's triangle ids are local.
-  mesh::MeshView part_mesh(int32_t p) const {
-    return {current_positions_, topo_.triangles.data() + part_begin(p), topo_.vertex_count,
-            part_size(p)};
+  /// Part p's triangles over a whole frame's positions (by default the current frame's): its
+  /// tree's triangle ids are local.
+  mesh::MeshView part_mesh(int32_t p, const geom::Vec3d* positions = nullptr) const {
+    return {positions ? positions : current_positions_, topo_.triangles.data() + part_begin(p),
+            topo_.vertex_count, part_size(p)};
   }
+
+  /// A frame's positions on the device and the version of each part they hold: the current
+  /// frame's, or the staged one's when its work is queued ahead (queue_ahead).
+  struct FrameView {
+    const geom::Vec3d* positions = nullptr;
+    std::vector<uint64_t> versions;  ///< per part
+  };
+  FrameView current_view() const { return {current_positions_, part_versions()}; }
 
   /// The versions of a frame whose parts moved as `moved` says (empty: all of them).
   std::vector<uint64_t> next_versions(std::span<const uint8_t> moved) {
@@ -495,6 +493,7 @@ class CudaBackendImpl final : public CudaBackend {
   void drop_staged_positions() {
     if (!staged_) return;
     staged_ = false;
+    release_recorded_ = false;  // work may have been queued ahead on the slot it was to fill
     if (staged_copy_pending_) {
       staged_copy_pending_ = false;
       return;
@@ -506,20 +505,72 @@ class CudaBackendImpl final : public CudaBackend {
     if (!topology_) throw InternalError("cuda backend: no topology set");
   }
 
-  /// Queues part p's refit; `timed`: between the refit timer's events, which a refit queued
-  /// ahead by the scan leaves out (the scan's timer covers it, and refit_part() then reports
-  /// 0), so that the scan's launches follow one another with no other step between them.
-  void queue_refit(int32_t p, bool timed) {
+  /// Queues part p's refit to `view`'s positions; `timed`: between the refit timer's events,
+  /// which a refit queued ahead by the scan leaves out (the scan's timer covers it, and
+  /// refit_part() then reports 0), so that the scan's launches follow one another with no other
+  /// step between them.
+  void queue_refit(int32_t p, bool timed, const FrameView& view) {
     if (part_size(p) == 0) return;  // built empty: nothing to refit
     if (timed) refit_timer_.start(stream());
-    trees_[p]->refit(part_mesh(p), planes_.data() + part_begin(p), stream());
+    trees_[p]->refit(part_mesh(p, view.positions), planes_.data() + part_begin(p), stream());
     if (timed) {
       refit_timer_.stop_async(stream());
       refit_pending_ = true;
     }
-    part_[p].tree_version = part_[p].version;
-    part_[p].planes_version = part_[p].version;
+    ++tree_changes_;
+    part_[p].tree_version = view.versions[p];
+    part_[p].planes_version = view.versions[p];
     part_[p].quality_ready = false;
+  }
+  /// Whether part p has a tree built that does not fit `view`'s positions.
+  bool needs_refit(int32_t p, const FrameView& view) const {
+    return part_[p].tree_built && part_[p].tree_version != view.versions[p] && part_size(p) > 0;
+  }
+
+  /// A frame's work up to its scan's wait, for `view`: the refits of the built trees that do
+  /// not fit it and the detect queued behind them (speculate_detect) on the main stream, and on
+  /// the side stream the scan of `parts` and those trees' qualities, into host memory. The walks
+  /// need the refit's boxes and planes, not the scan or the quality: the side stream waits for
+  /// the frame's positions (`timer`'s start) for the scan and for the refits (an event) for the
+  /// qualities, and is queued last, once the host has queued the main stream's work, so that
+  /// the walks do not wait for it. `timer` stops when the side stream is done. Returns the parts
+  /// refit.
+  std::vector<int32_t> queue_frame(std::span<const int32_t> parts, const FrameView& view,
+                                   EventTimer& timer) {
+    const cudaStream_t s = stream(), side = side_stream_->get();
+    timer.start(s);
+    std::vector<int32_t> refit;
+    for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
+      if (needs_refit(p, view)) refit.push_back(p);
+    for (int32_t p : refit) queue_refit(p, /*timed=*/false, view);  // its time is the scan's
+    refits_queued_.record(s);
+    speculate_detect(view);
+
+    SNAG_CUDA_CHECK(cudaStreamWaitEvent(side, timer.start_event(), 0));
+    // One launch per part; the last publishes the counts into host memory (none: no launch,
+    // and the counts stay zero).
+    size_t last_scanned = parts.size();
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (part_size(parts[i]) > 0) last_scanned = i;
+    ScanCounts* const counts = scan_counts_host_.data();
+    *counts = {};
+    // A scan cut short (an exception between its launches and its counts read) or whose counts
+    // were wrong may have left counts in the counters, which only a whole scan zeroes: cleared
+    // first.
+    if (scan_pending_)
+      SNAG_CUDA_CHECK(cudaMemsetAsync(scan_counters_.data(), 0, sizeof(ScanCounters), side));
+    scan_pending_ = true;
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (part_size(parts[i]) > 0)
+        launch_scan_degenerate(view.positions, topo_.triangles.data(), part_begin(parts[i]),
+                               part_size(parts[i]), mapped(scan_degenerate_host_.data()),
+                               mapped(scan_uncertain_host_.data()), topo_.triangle_count,
+                               scan_counters_.data(), i == last_scanned ? mapped(counts) : nullptr,
+                               side);
+    if (!refit.empty()) refits_queued_.wait_on(side);
+    for (int32_t p : refit) trees_[p]->queue_quality(side);
+    timer.stop_async(side);
+    return refit;
   }
 
   /// Stage times whose stop events the stream has passed (called after a wait).
@@ -613,8 +664,10 @@ class CudaBackendImpl final : public CudaBackend {
   const uint8_t* flagged_owned_edges() const {
     return flagged_.empty() ? topo_.owned_edges.data() : topo_.frame_owned_edges.data();
   }
-  void queue_detect(detect::FilterUse use, std::span<const int32_t> checks, const uint8_t* owned);
-  void speculate_detect();
+  void queue_detect(detect::FilterUse use, std::span<const int32_t> checks, const uint8_t* owned,
+                    const FrameView& view);
+  void speculate_detect(const FrameView& view);
+  void queue_ahead();
   std::vector<uint64_t> part_versions() const {
     std::vector<uint64_t> versions(part_.size());
     for (size_t p = 0; p < part_.size(); ++p) versions[p] = part_[p].version;
@@ -632,7 +685,7 @@ class CudaBackendImpl final : public CudaBackend {
     bool queued = false;
     DetectCall call;
     std::vector<int32_t> degenerate;  ///< flagged_ then
-    uint64_t builds = 0;              ///< builds_ then
+    uint64_t tree_changes = 0;        ///< tree_changes_ then
     const geom::Vec3d* positions = nullptr;
     std::vector<uint64_t> versions;  ///< each part's
   };
@@ -663,6 +716,7 @@ class CudaBackendImpl final : public CudaBackend {
   Event refits_queued_;     // the main stream's refits queued ahead by a scan
   Event pinned_copied_[2];  // the last copy out of each pinned buffer
   Event slot_released_;     // main-stream work queued before a staged copy
+  bool release_recorded_ = false;  // slot_released_ recorded by queue_ahead for the next staging
   Event staged_ready_;      // the staged copy
   bool staged_ = false;
   bool staged_copy_pending_ = false;  // staged_, its host copy not made yet (copy_staged_positions)
@@ -680,13 +734,31 @@ class CudaBackendImpl final : public CudaBackend {
   PinnedBuffer<int32_t> scan_degenerate_host_, scan_uncertain_host_;  // written by the scan kernel
   std::vector<int32_t> flagged_;  ///< degenerate ids flagged on the device for the last frame
   DeviceBuffer<FrameCounters> counters_;
-  PinnedBuffer<FrameCounters> counters_host_;  // the detect's, written by finish_kernel
+  // The detect's counts, pairs and uncertain tests in host memory, written by finish_kernel (or
+  // copied, for large frames): two sets, so that a detect queued ahead (queue_ahead) writes one
+  // while the host decodes the other. results_set_ is the one the next run writes.
+  PinnedBuffer<FrameCounters> counters_host_[2];
+  PinnedBuffer<uint64_t> host_pairs_[2], host_uncertain_[2];  // pairs: keys with their status
+  HostResults host_results_[2];  // device addresses of each set
+  int results_set_ = 0;
   DeviceBuffer<ScanCounters> scan_counters_;   // zero between scans (the scan leaves them so)
   bool scan_pending_ = false;  // a scan's launches queued, its counts not yet read and accepted
   PinnedBuffer<ScanCounts> scan_counts_host_;  // the last scan's counts, written by its kernel
   DetectCall last_detect_;
   Speculation speculation_;
-  uint64_t builds_ = 0;
+  /// The next frame's work queued at the end of a detect (queue_ahead) and what it assumed.
+  struct Ahead {
+    bool queued = false;
+    std::vector<int32_t> parts;  ///< scanned
+    std::vector<int32_t> refit;  ///< refit, their qualities queued
+    const geom::Vec3d* positions = nullptr;
+    std::vector<uint64_t> versions;  ///< each part's
+    uint64_t tree_changes = 0;       ///< tree_changes_ then
+  };
+  Ahead ahead_;
+  EventTimer ahead_timer_;  // from the staged positions ready to the ahead's side stream done
+  bool scanned_ = false;    // the current frame's positions went through a scan
+  uint64_t tree_changes_ = 0;  // builds and refits queued: a detect queued ahead read the trees
   unsigned max_blocks_ = 1;
   EventTimer detect_timer_;
   DeviceBuffer<uint64_t> listed_;    // a check's candidate pairs, from its walks to its tests
@@ -705,7 +777,6 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<unsigned char> temp_;
   DeviceBuffer<unsigned> finish_ranks_, finish_tickets_;  // FinishScratch, zero between runs
   // Results in host memory: written by finish_kernel (small frames) or copied (large ones).
-  PinnedBuffer<uint64_t> host_pairs_, host_uncertain_;  // HostResults' (pairs with status)
   PinnedBuffer<uint64_t> keys_host_, uncertain_host_;
   PinnedBuffer<uint8_t> status_host_;
   // Stage timers whose stop may still be queued: read (and waited for) by collect_times().
@@ -713,7 +784,6 @@ class CudaBackendImpl final : public CudaBackend {
   mutable bool upload_pending_ = false, build_pending_ = false, refit_pending_ = false;
   EventTimer narrow_timer_;
   unsigned long long finish_limit_ = kFinishLimit;
-  HostResults host_results_;  // device addresses of the host_* buffers
   int64_t initial_capacity_ = 1 << 16;
   int pair_bits_ = 1, edge_bits_ = 1;
 };
@@ -746,17 +816,17 @@ const uint8_t* CudaBackendImpl::prepare_degenerate(std::span<const int32_t> dege
 /// (up to kFinishLimit results) the ranking straight into host memory. Buffers are
 /// sized by earlier frames; a count past a capacity is counted, not stored (see detect_checks).
 void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_t> checks,
-                                   const uint8_t* owned) {
+                                   const uint8_t* owned, const FrameView& view) {
   const cudaStream_t s = stream();
   const int32_t n = topo_.triangle_count;
   detect_timer_.start(s);
   for (int32_t c : checks)
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b}) {
       PartState& part = part_[p];
-      if (part.planes_version == part.version || part_size(p) == 0) continue;
-      launch_planes(current_positions_, topo_.triangles.data() + part_begin(p), part_size(p),
+      if (part.planes_version == view.versions[p] || part_size(p) == 0) continue;
+      launch_planes(view.positions, topo_.triangles.data() + part_begin(p), part_size(p),
                     planes_.data() + part_begin(p), s);
-      part.planes_version = part.version;
+      part.planes_version = view.versions[p];
     }
   // The fans of the parts checked against themselves, which their subwalks and pair tests read
   // (each computed in its part's walk kernel: FanJob).
@@ -768,7 +838,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   if (fans && flagged_.empty())
     drop = {later_neighbors_.data(), topo_.triangles.data(), topo_.fan_clear.data()};
   PairInputs inputs;
-  inputs.frame = {current_positions_, planes_.data(), fans ? topo_.fan_clear.data() : nullptr};
+  inputs.frame = {view.positions, planes_.data(), fans ? topo_.fan_clear.data() : nullptr};
   inputs.topology.triangles = topo_.triangles.data();
   inputs.topology.edges = topo_.edges.data();
   inputs.topology.triangle_edges = topo_.triangle_edges.data();
@@ -790,7 +860,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   const CandidateList listed{listed_.data(), candidate_capacity(), screened_.data(),
                              screened_expected_};
   const SubwalkList subwalks{subwalks_.data(), subwalks_.capacity(), subwalks_expected_};
-  HostResults out = host_results_;
+  HostResults out = host_results_[results_set_];
   out.limit = finish_limit_;
   launch_clear_frame(counters_.data(), table_.data(), table_.capacity(), s);
   const bool time_each = checks.size() > 1;
@@ -810,7 +880,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
       FanJob part_fans;
       if (fans) {
         const int32_t first = topology_->layout.vertex_begin[check.a];
-        part_fans = {current_positions_, planes_.data(),
+        part_fans = {view.positions, planes_.data(),
                      {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
                      topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data()};
       }
@@ -829,34 +899,65 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
   narrow_timer_.stop_async(s);
   launch_expand(hits_.data(), hits_.capacity(), duplicates_.data(), duplicates_.capacity(),
                 expand_expected_, counters_.data(), topo_.edge_face_offsets.data(),
-                topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_, current_positions_,
+                topo_.edge_faces.data(), topo_.degenerate.data(), pair_bits_, view.positions,
                 topo_.triangles.data(), set, max_blocks_, s);
   launch_finish(counters_.data(), set, uncertain_.data(), uncertain_.capacity(), finish_expected_,
                 {finish_ranks_.data(), finish_tickets_.data()}, out, s);
   detect_timer_.stop_async(s);
 }
 
-/// Queued at the end of the scan, before its wait, so that the device goes on from the scan
-/// to the checks while the host reads the scan and decides: the last frame's checks, with its
+/// Queued before the scan's wait (queue_frame), so that the device goes on from the refits to
+/// the checks while the host reads the scan and decides: the last frame's checks, with its
 /// filter use and its degenerate triangles (usually none, and then this frame's scan finds
-/// none either). Only when every checked part's tree fits the current positions (the refits
-/// queued ahead). detect_checks takes it when its call turns out to be the one assumed and no
-/// tree was rebuilt in between; else it queues the frame again (the stream orders the runs,
-/// and each run starts by clearing what it fills).
-void CudaBackendImpl::speculate_detect() {
+/// none either), over `view`'s positions. Only when every checked part's tree fits them (the
+/// refits queued before). detect_checks takes it when its call turns out to be the one assumed
+/// on those positions and no tree was built or refit in between; else it queues the frame
+/// again (the stream orders the runs, and each run starts by clearing what it fills).
+void CudaBackendImpl::speculate_detect(const FrameView& view) {
   speculation_.queued = false;
   if (!last_detect_.valid) return;
   for (int32_t c : last_detect_.checks)
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b})
-      if (part_size(p) > 0 && (!part_[p].tree_built || part_[p].tree_version != part_[p].version))
+      if (part_size(p) > 0 && (!part_[p].tree_built || part_[p].tree_version != view.versions[p]))
         return;
-  queue_detect(last_detect_.use, last_detect_.checks, flagged_owned_edges());
+  queue_detect(last_detect_.use, last_detect_.checks, flagged_owned_edges(), view);
   speculation_.queued = true;
   speculation_.call = last_detect_;
   speculation_.degenerate = flagged_;
-  speculation_.builds = builds_;
-  speculation_.positions = current_positions_;
-  speculation_.versions = part_versions();
+  speculation_.tree_changes = tree_changes_;
+  speculation_.positions = view.positions;
+  speculation_.versions = view.versions;
+}
+
+/// Frame k + 1's work, queued at the end of frame k's detect once its results are in host
+/// memory, when the caller staged k + 1 and frame k went through a scan (a checker's frame):
+/// what k + 1's scan would queue (queue_frame: refits, the speculated detect, the scan and the
+/// qualities) over the staged positions, so that the device goes on from k's checks to k + 1's
+/// while the host decodes k's results, resolves its uncertain tests and takes the next frame
+/// (a checker's frame spends ~60 us of host time around the device's ~110 us at 36K,
+/// cuda/NOTES.md). k + 1's scan and detect take it when their calls turn out to be the ones
+/// assumed; else they wait for it and queue their own. Its detect writes the other set of host
+/// results, the one k's are not decoded from; the refits change the trees under a frame whose
+/// checks are done (a call for k after this refits them back: needs_refit).
+void CudaBackendImpl::queue_ahead() {
+  if (!staged_ || staged_copy_pending_ || on_resident_ || !scanned_ || !last_detect_.valid) return;
+  const cudaStream_t s = stream();
+  // The current frame's work on its slot ends here: the frame after the staged one may be
+  // copied into it while the staged one is checked (stage_part_positions).
+  slot_released_.record(s);
+  release_recorded_ = true;
+  staged_ready_.wait_on(s);
+  const FrameView view{positions_[1 - positions_slot_].data(), staged_version_};
+  std::vector<int32_t> parts;
+  for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
+    if (staged_moved_.empty() || staged_moved_[p]) parts.push_back(p);
+  results_set_ = 1 - results_set_;
+  ahead_.refit = queue_frame(parts, view, ahead_timer_);
+  ahead_.queued = true;
+  ahead_.parts = std::move(parts);
+  ahead_.positions = view.positions;
+  ahead_.versions = view.versions;
+  ahead_.tree_changes = tree_changes_;
 }
 
 detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> degenerate,
@@ -866,14 +967,23 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   detect::FilteredFrame frame;
   if (topo_.triangle_count == 0) return frame;
   const auto start = Clock::now();
+  const FrameView view = current_view();
+  // Trees refit ahead to the staged frame (queue_ahead) when this frame's checks are asked
+  // again: refit back (which voids the speculation).
+  for (int32_t c : checks)
+    for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b})
+      if (needs_refit(p, view)) queue_refit(p, /*timed=*/true, view);
   const bool speculated =
       speculation_.queued && speculation_.call.use == use &&
       std::ranges::equal(speculation_.call.checks, checks) &&
-      std::ranges::equal(speculation_.degenerate, degenerate) && speculation_.builds == builds_ &&
-      speculation_.positions == current_positions_ && speculation_.versions == part_versions();
+      std::ranges::equal(speculation_.degenerate, degenerate) &&
+      speculation_.tree_changes == tree_changes_ && speculation_.positions == view.positions &&
+      speculation_.versions == view.versions;
   speculation_.queued = false;
+  // The set the run writes in host memory; a detect queued ahead writes the other one.
+  const int set = results_set_;
   const uint8_t* owned = prepare_degenerate(degenerate);
-  if (!speculated) queue_detect(use, checks, owned);
+  if (!speculated) queue_detect(use, checks, owned, view);
   last_detect_ = {true, use, std::vector<int32_t>(checks.begin(), checks.end())};
 
   copy_staged_positions();  // when no scan came first
@@ -882,7 +992,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   FrameCounters c{};
   for (;;) {
     detect_timer_.elapsed();
-    c = *counters_host_.data();
+    c = *counters_host_[set].data();
     if (c.hits <= hits_.capacity() && c.uncertain <= uncertain_.capacity() &&
         c.duplicates <= duplicates_.capacity() && c.pairs <= pair_keys_.capacity() &&
         c.listed_most <= candidate_capacity() && c.subwalks_most <= subwalks_.capacity())
@@ -892,7 +1002,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     // each undercounts the stages after it, and a frame can take up to four runs. None is
     // ever lost.
     fit_counts(c);
-    queue_detect(use, checks, owned);
+    queue_detect(use, checks, owned, view);
   }
   collect_times();
   {
@@ -957,6 +1067,12 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
     timer_.stop_async(s);
     times_.classify += timer_.elapsed();
   }
+  // Next frames start with this one's counts and some slack, so that creeping counts rarely
+  // run a frame twice (buffers never shrink). Growing discards the device buffers' contents,
+  // which this frame's results (in host memory now) no longer need.
+  fit_counts(c);
+  // The staged frame's work, queued before this frame's results are decoded below.
+  queue_ahead();
 
   // A frame's results as finish_kernel wrote them (pairs with their status above the key), or
   // the device-wide sorts' keys and statuses.
@@ -970,17 +1086,15 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
                                                                status_host_.data()[i]};
                          })
           : decode_pairs(pair_count, frame, [&](size_t i) {
-              const uint64_t packed = host_pairs_.data()[i];
+              const uint64_t packed = host_pairs_[set].data()[i];
               return std::pair<uint64_t, uint8_t>{packed & ((uint64_t{1} << kStatusShift) - 1),
                                                   static_cast<uint8_t>(packed >> kStatusShift)};
             });
-  decode_tasks(large_tasks ? uncertain_host_.data() : host_uncertain_.data(), task_count, frame);
+  decode_tasks(large_tasks ? uncertain_host_.data() : host_uncertain_[set].data(), task_count,
+               frame);
   frame.filtered_tests = static_cast<int64_t>(c.misses + c.hits) +
                          static_cast<int64_t>(frame.pairs.size()) - uncertain_kinds;
   frame.classify_seconds = seconds_since(classify_start);
-  // Next frames start with this one's counts and some slack, so that creeping counts rarely
-  // run a frame twice (buffers never shrink).
-  fit_counts(c);
   return frame;
 }
 

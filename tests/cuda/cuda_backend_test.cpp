@@ -529,6 +529,74 @@ TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
   }
 }
 
+TEST(CudaBackend, FramesQueuedAheadGiveThePlainAnswers) {
+  SNAG_REQUIRE_GPU();
+  // A detect that finds the next frame staged queues that frame's refit, scan, quality and
+  // detect before it returns. Each way the next calls can differ from what was queued gives
+  // the CPU's answers: the queued work taken whole; degenerate triangles appearing and going
+  // (the queued detect assumed the last frame's); a rebuild; the current frame's detect and
+  // quality asked again after the next one was queued (its trees refit back); a frame set that
+  // is not the staged one; and buffers too small for a frame, grown while work is queued ahead.
+  // Compared filtered frame for filtered frame (the checker's tests, StagedNextFrames and the
+  // scenes, take the same path and compare the resolved pairs with brute force).
+  SmallMesh base = folded_grid(40, 14);
+  std::vector<SmallMesh> frames;
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int f = 0; f < 14; ++f) {
+    SmallMesh frame = base;
+    if (f == 4 || f == 5 || f == 9) {
+      // Zero area the filter certifies: a triangle's third corner onto its first.
+      for (int t = f; t < static_cast<int>(frame.triangles.size()); t += 37) {
+        const geom::Tri tri = frame.triangles[t];
+        frame.positions[tri.v[2]] = frame.positions[tri.v[0]];
+      }
+    }
+    frames.push_back(frame);
+    for (auto& p : base.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+  }
+  // Another frame's positions at another address, with zero-area triangles where frame 12 has
+  // none: a scan queued ahead for frame 12 would not find them.
+  const SmallMesh unrelated = frames[4];
+  const detect::Topology topology =
+      detect::make_topology(base.triangles, static_cast<int32_t>(base.positions.size()));
+  for (int64_t capacity : {int64_t{0}, int64_t{1}}) {
+    auto cpu = detect::make_cpu_backend(2);
+    auto gpu = gpu_backend();
+    if (capacity > 0) gpu->set_result_capacity(capacity);
+    cpu->set_topology(topology);
+    gpu->set_topology(topology);
+    for (int f = 0; f < 14; ++f) {
+      const std::string what = "capacity " + std::to_string(capacity) + " frame " + std::to_string(f);
+      const bool build = f == 0 || f == 7;  // frame 7: a rebuild after its work was queued ahead
+      // Frame 11 is checked with frame 12 staged, then an unrelated frame of the same size comes.
+      const std::span<const geom::Vec3d> positions =
+          f == 12 ? std::span<const geom::Vec3d>(unrelated.positions) : frames[f].positions;
+      Filtered g;
+      gpu->set_positions(positions);
+      if (f + 1 < 14) gpu->stage_positions(frames[f + 1].positions);
+      g.scan = gpu->scan_degenerate();
+      if (build)
+        gpu->build();
+      else
+        gpu->refit();
+      g.quality = gpu->tree_quality();
+      g.frame = gpu->detect(g.scan.degenerate);
+      const Filtered c = filtered(*cpu, positions, build);
+      expect_same(c, g, what);
+      if (f == 3 || f == 8) {
+        // The current frame asked again, its next frame's work queued.
+        const detect::FilteredFrame again = gpu->detect(g.scan.degenerate);
+        EXPECT_EQ(again.pairs, c.frame.pairs) << what << ", asked again";
+        EXPECT_EQ(again.uncertain, c.frame.uncertain) << what << ", asked again";
+        EXPECT_EQ(again.candidate_pairs, c.frame.candidate_pairs) << what << ", asked again";
+        EXPECT_EQ(gpu->tree_quality(), c.quality) << what << ", asked again";
+      }
+    }
+  }
+}
+
 /// A scene checked frame after frame on both backends; `capacity` > 0 starts the GPU's result
 /// buffers (its subwalk and candidate lists included) that small, so that checks overflow them
 /// and run again.
