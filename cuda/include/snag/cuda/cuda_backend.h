@@ -24,12 +24,15 @@ int cuda_device_count();
 /// Device-side time of the last run of each stage, in milliseconds, from CUDA events recorded
 /// on the backend's stream around the stage's kernels and copies. Stages are queued without
 /// waiting where the interface allows: a checker's frame waits twice, at the end of the scan
-/// and at the end of detect().
+/// and at the end of detect(), and a detect that finds the next frame staged queues that
+/// frame's work before it returns.
 struct StageTimes {
   double upload = 0;    ///< positions: pinned host buffer to device
   double scan = 0;      ///< degenerate-triangle scan with its result on the host; in a checker's
                         ///< frame also the refit, the quality and the detect queued ahead of
-                        ///< their calls (the scan is queued after them, beside the detect)
+                        ///< their calls (the scan is queued after them, beside the detect).
+                        ///< When the frame was staged, all of it is queued at the end of the
+                        ///< previous frame's detect, and this is from then
   double build = 0;     ///< the whole GPU build, boxes and planes included
   double refit = 0;     ///< boxes and planes from the current positions (0 when refit() found
                         ///< the tree already fit to them, refit ahead in the scan or built)
