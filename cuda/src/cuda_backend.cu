@@ -83,6 +83,7 @@ class CudaBackendImpl final : public CudaBackend {
 
   std::string_view name() const override { return "cuda"; }
   std::string device_name() const override { return device_name_; }
+  AheadTaken ahead_taken() const override { return ahead_taken_; }
   StageTimes last_times() const override {
     collect_times();  // waits for stages still queued
     return times_;
@@ -197,6 +198,7 @@ class CudaBackendImpl final : public CudaBackend {
     } else {
       drop_staged_positions();
       release_recorded_ = false;  // it was for the slot the staged frame would have left
+      order_after_ahead();        // a scan queued ahead may still read the slot copied into
       const std::vector<uint64_t> versions = next_versions(moved);
       for (size_t p = 0; p < part_.size(); ++p) part_[p].version = versions[p];
       if (!on_resident_ && slot_version_[positions_slot_] == versions) {
@@ -233,7 +235,10 @@ class CudaBackendImpl final : public CudaBackend {
     if (slot_version_[positions_slot_] == versions) return;  // the next frame is this one
     const int slot = 1 - positions_slot_;
     pinned_copied_[slot].synchronize();
-    if (!release_recorded_) slot_released_.record(stream());
+    if (!release_recorded_ || slot != released_slot_) {
+      order_after_ahead();  // a scan queued ahead may still read the slot copied into
+      slot_released_.record(stream());
+    }
     release_recorded_ = false;
     slot_released_.wait_on(upload_stream_->get());
     staged_ = true;
@@ -286,6 +291,7 @@ class CudaBackendImpl final : public CudaBackend {
     // Work queued ahead for another frame than this one still writes the scan's buffers.
     if (ahead_.queued && !queued_ahead) side_stream_->synchronize();
     ahead_.queued = false;
+    ahead_taken_.scans += queued_ahead;
     const std::vector<int32_t> refit =
         queued_ahead ? std::move(ahead_.refit) : queue_frame(parts, view, timer_);
     EventTimer& timer = queued_ahead ? ahead_timer_ : timer_;
@@ -329,6 +335,8 @@ class CudaBackendImpl final : public CudaBackend {
       part.quality_ready = true;
       return;
     }
+    order_after_ahead();
+    note_reads(current_positions_);
     build_timer_.start(stream());
     trees_[p]->build(part_mesh(p), planes_.data() + part_begin(p), stream());
     if (topo_.has_fans)
@@ -357,6 +365,7 @@ class CudaBackendImpl final : public CudaBackend {
     // A tree refit ahead to the staged frame (queue_ahead) is refit back to this one first.
     if (needs_refit(p, current_view())) queue_refit(p, /*timed=*/true, current_view());
     if (part.quality_ready) return part.quality;
+    order_after_ahead();
     timer_.start(stream());
     trees_[p]->queue_quality(stream());
     timer_.stop_async(stream());
@@ -511,6 +520,8 @@ class CudaBackendImpl final : public CudaBackend {
   /// step between them.
   void queue_refit(int32_t p, bool timed, const FrameView& view) {
     if (part_size(p) == 0) return;  // built empty: nothing to refit
+    order_after_ahead();
+    note_reads(view.positions);
     if (timed) refit_timer_.start(stream());
     trees_[p]->refit(part_mesh(p, view.positions), planes_.data() + part_begin(p), stream());
     if (timed) {
@@ -522,6 +533,20 @@ class CudaBackendImpl final : public CudaBackend {
     part_[p].planes_version = view.versions[p];
     part_[p].quality_ready = false;
   }
+  /// Main-stream work queued from here on runs after the side-stream work queued ahead (the
+  /// scan reads the staged slot; the qualities read the trees and their quality scratch), so
+  /// that a call out of a checker's order (a tree built, refit or measured, another frame set)
+  /// does not run beside it.
+  void order_after_ahead() {
+    if (ahead_.queued) SNAG_CUDA_CHECK(cudaStreamWaitEvent(stream(), ahead_timer_.stop_event(), 0));
+  }
+  /// Work that reads `positions` is being queued: when they are the slot released by
+  /// queue_ahead, that release came too early for the next staged copy.
+  void note_reads(const geom::Vec3d* positions) {
+    if (release_recorded_ && positions == positions_[released_slot_].data())
+      release_recorded_ = false;
+  }
+
   /// Whether part p has a tree built that does not fit `view`'s positions.
   bool needs_refit(int32_t p, const FrameView& view) const {
     return part_[p].tree_built && part_[p].tree_version != view.versions[p] && part_size(p) > 0;
@@ -538,6 +563,7 @@ class CudaBackendImpl final : public CudaBackend {
   std::vector<int32_t> queue_frame(std::span<const int32_t> parts, const FrameView& view,
                                    EventTimer& timer) {
     const cudaStream_t s = stream(), side = side_stream_->get();
+    note_reads(view.positions);
     timer.start(s);
     std::vector<int32_t> refit;
     for (int32_t p = 0; p < static_cast<int32_t>(part_.size()); ++p)
@@ -683,6 +709,7 @@ class CudaBackendImpl final : public CudaBackend {
   /// A detect queued ahead by the scan (speculate_detect) and what it assumed.
   struct Speculation {
     bool queued = false;
+    bool ahead = false;  ///< queued by queue_ahead
     DetectCall call;
     std::vector<int32_t> degenerate;  ///< flagged_ then
     uint64_t tree_changes = 0;        ///< tree_changes_ then
@@ -717,6 +744,7 @@ class CudaBackendImpl final : public CudaBackend {
   Event pinned_copied_[2];  // the last copy out of each pinned buffer
   Event slot_released_;     // main-stream work queued before a staged copy
   bool release_recorded_ = false;  // slot_released_ recorded by queue_ahead for the next staging
+  int released_slot_ = 0;          // the slot it released
   Event staged_ready_;      // the staged copy
   bool staged_ = false;
   bool staged_copy_pending_ = false;  // staged_, its host copy not made yet (copy_staged_positions)
@@ -756,6 +784,7 @@ class CudaBackendImpl final : public CudaBackend {
     uint64_t tree_changes = 0;       ///< tree_changes_ then
   };
   Ahead ahead_;
+  AheadTaken ahead_taken_;
   EventTimer ahead_timer_;  // from the staged positions ready to the ahead's side stream done
   bool scanned_ = false;    // the current frame's positions went through a scan
   uint64_t tree_changes_ = 0;  // builds and refits queued: a detect queued ahead read the trees
@@ -819,6 +848,7 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
                                    const uint8_t* owned, const FrameView& view) {
   const cudaStream_t s = stream();
   const int32_t n = topo_.triangle_count;
+  note_reads(view.positions);
   detect_timer_.start(s);
   for (int32_t c : checks)
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b}) {
@@ -922,6 +952,7 @@ void CudaBackendImpl::speculate_detect(const FrameView& view) {
         return;
   queue_detect(last_detect_.use, last_detect_.checks, flagged_owned_edges(), view);
   speculation_.queued = true;
+  speculation_.ahead = false;
   speculation_.call = last_detect_;
   speculation_.degenerate = flagged_;
   speculation_.tree_changes = tree_changes_;
@@ -946,6 +977,7 @@ void CudaBackendImpl::queue_ahead() {
   // copied into it while the staged one is checked (stage_part_positions).
   slot_released_.record(s);
   release_recorded_ = true;
+  released_slot_ = positions_slot_;
   staged_ready_.wait_on(s);
   const FrameView view{positions_[1 - positions_slot_].data(), staged_version_};
   std::vector<int32_t> parts;
@@ -953,6 +985,7 @@ void CudaBackendImpl::queue_ahead() {
     if (staged_moved_.empty() || staged_moved_[p]) parts.push_back(p);
   results_set_ = 1 - results_set_;
   ahead_.refit = queue_frame(parts, view, ahead_timer_);
+  speculation_.ahead = speculation_.queued;
   ahead_.queued = true;
   ahead_.parts = std::move(parts);
   ahead_.positions = view.positions;
@@ -980,6 +1013,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
       speculation_.tree_changes == tree_changes_ && speculation_.positions == view.positions &&
       speculation_.versions == view.versions;
   speculation_.queued = false;
+  ahead_taken_.detects += speculated && speculation_.ahead;
   // The set the run writes in host memory; a detect queued ahead writes the other one.
   const int set = results_set_;
   const uint8_t* owned = prepare_degenerate(degenerate);

@@ -72,6 +72,14 @@ class CudaBackend : public detect::Backend {
   virtual std::vector<geom::Box3f> node_boxes() = 0;
   /// The device's name, as the driver reports it.
   virtual std::string device_name() const = 0;
+  /// How many scans and detects, since the backend was made, took the work queued for them at
+  /// the end of the previous frame's detect (a frame staged while the one before it was
+  /// checked), instead of queueing their own.
+  struct AheadTaken {
+    int64_t scans = 0;
+    int64_t detects = 0;
+  };
+  virtual AheadTaken ahead_taken() const = 0;
 };
 
 /// The CUDA backend on device `device` (0-based). Throws snag::UsageError when there is no such
