@@ -284,8 +284,7 @@ class CudaBackendImpl final : public CudaBackend {
     if (topo_.triangle_count == 0) return scan;
     scanned_ = true;
     const FrameView view = current_view();
-    const bool queued_ahead = ahead_.queued && ahead_.positions == view.positions &&
-                              ahead_.versions == view.versions &&
+    const bool queued_ahead = ahead_.queued && ahead_.view == view &&
                               ahead_.tree_changes == tree_changes_ &&
                               std::ranges::equal(ahead_.parts, parts);
     // Work queued ahead for another frame than this one still writes the scan's buffers.
@@ -338,7 +337,7 @@ class CudaBackendImpl final : public CudaBackend {
     order_after_ahead();
     note_reads(current_positions_);
     build_timer_.start(stream());
-    trees_[p]->build(part_mesh(p), planes_.data() + part_begin(p), stream());
+    trees_[p]->build(part_mesh(p, current_positions_), planes_.data() + part_begin(p), stream());
     if (topo_.has_fans)
       launch_later_neighbors(trees_[p]->view(), part_begin(p), topo_.triangles.data(),
                              {topo_.fan_begin.data(), topo_.fan_steps.data()},
@@ -363,7 +362,8 @@ class CudaBackendImpl final : public CudaBackend {
     require_topology();
     PartState& part = part_[p];
     // A tree refit ahead to the staged frame (queue_ahead) is refit back to this one first.
-    if (needs_refit(p, current_view())) queue_refit(p, /*timed=*/true, current_view());
+    if (const FrameView view = current_view(); needs_refit(p, view))
+      queue_refit(p, /*timed=*/true, view);
     if (part.quality_ready) return part.quality;
     order_after_ahead();
     timer_.start(stream());
@@ -420,11 +420,9 @@ class CudaBackendImpl final : public CudaBackend {
   int32_t part_size(int32_t p) const {
     return topology_->layout.triangle_begin[p + 1] - topology_->layout.triangle_begin[p];
   }
-  /// Part p's triangles over a whole frame's positions (by default the current frame's): its
-  /// tree's triangle ids are local.
-  mesh::MeshView part_mesh(int32_t p, const geom::Vec3d* positions = nullptr) const {
-    return {positions ? positions : current_positions_, topo_.triangles.data() + part_begin(p),
-            topo_.vertex_count, part_size(p)};
+  /// Part p's triangles over a whole frame's positions: its tree's triangle ids are local.
+  mesh::MeshView part_mesh(int32_t p, const geom::Vec3d* positions) const {
+    return {positions, topo_.triangles.data() + part_begin(p), topo_.vertex_count, part_size(p)};
   }
 
   /// A frame's positions on the device and the version of each part they hold: the current
@@ -432,6 +430,7 @@ class CudaBackendImpl final : public CudaBackend {
   struct FrameView {
     const geom::Vec3d* positions = nullptr;
     std::vector<uint64_t> versions;  ///< per part
+    bool operator==(const FrameView&) const = default;
   };
   FrameView current_view() const { return {current_positions_, part_versions()}; }
 
@@ -713,8 +712,7 @@ class CudaBackendImpl final : public CudaBackend {
     DetectCall call;
     std::vector<int32_t> degenerate;  ///< flagged_ then
     uint64_t tree_changes = 0;        ///< tree_changes_ then
-    const geom::Vec3d* positions = nullptr;
-    std::vector<uint64_t> versions;  ///< each part's
+    FrameView view;                   ///< the frame it checks
   };
 
   SelectDevice select_;
@@ -779,9 +777,8 @@ class CudaBackendImpl final : public CudaBackend {
     bool queued = false;
     std::vector<int32_t> parts;  ///< scanned
     std::vector<int32_t> refit;  ///< refit, their qualities queued
-    const geom::Vec3d* positions = nullptr;
-    std::vector<uint64_t> versions;  ///< each part's
-    uint64_t tree_changes = 0;       ///< tree_changes_ then
+    FrameView view;              ///< the staged frame
+    uint64_t tree_changes = 0;   ///< tree_changes_ then
   };
   Ahead ahead_;
   AheadTaken ahead_taken_;
@@ -956,8 +953,7 @@ void CudaBackendImpl::speculate_detect(const FrameView& view) {
   speculation_.call = last_detect_;
   speculation_.degenerate = flagged_;
   speculation_.tree_changes = tree_changes_;
-  speculation_.positions = view.positions;
-  speculation_.versions = view.versions;
+  speculation_.view = view;
 }
 
 /// Frame k + 1's work, queued at the end of frame k's detect once its results are in host
@@ -988,8 +984,7 @@ void CudaBackendImpl::queue_ahead() {
   speculation_.ahead = speculation_.queued;
   ahead_.queued = true;
   ahead_.parts = std::move(parts);
-  ahead_.positions = view.positions;
-  ahead_.versions = view.versions;
+  ahead_.view = view;
   ahead_.tree_changes = tree_changes_;
 }
 
@@ -1010,8 +1005,7 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
       speculation_.queued && speculation_.call.use == use &&
       std::ranges::equal(speculation_.call.checks, checks) &&
       std::ranges::equal(speculation_.degenerate, degenerate) &&
-      speculation_.tree_changes == tree_changes_ && speculation_.positions == view.positions &&
-      speculation_.versions == view.versions;
+      speculation_.tree_changes == tree_changes_ && speculation_.view == view;
   speculation_.queued = false;
   ahead_taken_.detects += speculated && speculation_.ahead;
   // The set the run writes in host memory; a detect queued ahead writes the other one.

@@ -52,15 +52,20 @@ Filtered filtered(detect::Backend& backend, std::span<const geom::Vec3d> positio
   return f;
 }
 
+void expect_same_frame(const detect::FilteredFrame& cpu, const detect::FilteredFrame& gpu,
+                       const std::string& what) {
+  EXPECT_EQ(cpu.pairs, gpu.pairs) << what;
+  EXPECT_EQ(cpu.kind_certain, gpu.kind_certain) << what;
+  EXPECT_EQ(cpu.uncertain, gpu.uncertain) << what;
+  EXPECT_EQ(cpu.candidate_pairs, gpu.candidate_pairs) << what;
+  EXPECT_EQ(cpu.filtered_tests, gpu.filtered_tests) << what;
+}
+
 void expect_same(const Filtered& cpu, const Filtered& gpu, const std::string& what) {
   EXPECT_EQ(cpu.scan.degenerate, gpu.scan.degenerate) << what;
   EXPECT_EQ(cpu.scan.uncertain, gpu.scan.uncertain) << what;
   EXPECT_EQ(cpu.quality, gpu.quality) << what;  // bit for bit
-  EXPECT_EQ(cpu.frame.pairs, gpu.frame.pairs) << what;
-  EXPECT_EQ(cpu.frame.kind_certain, gpu.frame.kind_certain) << what;
-  EXPECT_EQ(cpu.frame.uncertain, gpu.frame.uncertain) << what;
-  EXPECT_EQ(cpu.frame.candidate_pairs, gpu.frame.candidate_pairs) << what;
-  EXPECT_EQ(cpu.frame.filtered_tests, gpu.frame.filtered_tests) << what;
+  expect_same_frame(cpu.frame, gpu.frame, what);
 }
 
 /// Both backends on one mesh, one frame, from a fresh build.
@@ -537,11 +542,10 @@ inline std::vector<SmallMesh> wandering_frames(int w, int h, int count, uint32_t
   for (auto& p : mesh.positions) p = geom::Vec3d{4 * p.x, 4 * p.y, 4 * p.z};
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> step(-1, 1);
+  // Zero area as brute_force decides it: exact integer predicates.
   auto flat = [&](const geom::Tri& t) {
-    const geom::Vec3d a = mesh.positions[t.v[0]], b = mesh.positions[t.v[1]],
-                      c = mesh.positions[t.v[2]];
-    const geom::Vec3d u = b - a, v = c - a;  // small integers: exact
-    return u.y * v.z - u.z * v.y == 0 && u.z * v.x - u.x * v.z == 0 && u.x * v.y - u.y * v.x == 0;
+    const IntegerPredicates pred{mesh.positions.data()};
+    return IntegerResolver::decide(geom::is_degenerate(pred, t.v[0], t.v[1], t.v[2]));
   };
   std::vector<SmallMesh> frames;
   for (int f = 0; f < count; ++f) {
@@ -558,15 +562,6 @@ inline std::vector<SmallMesh> wandering_frames(int w, int h, int count, uint32_t
     }
   }
   return frames;
-}
-
-void expect_same_frame(const detect::FilteredFrame& cpu, const detect::FilteredFrame& gpu,
-                       const std::string& what) {
-  EXPECT_EQ(cpu.pairs, gpu.pairs) << what;
-  EXPECT_EQ(cpu.kind_certain, gpu.kind_certain) << what;
-  EXPECT_EQ(cpu.uncertain, gpu.uncertain) << what;
-  EXPECT_EQ(cpu.candidate_pairs, gpu.candidate_pairs) << what;
-  EXPECT_EQ(cpu.filtered_tests, gpu.filtered_tests) << what;
 }
 
 TEST(CudaBackend, FramesQueuedAheadGiveThePlainAnswers) {
