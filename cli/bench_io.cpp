@@ -4,12 +4,15 @@
 //               in full, and frames read in sequence, where only positions are parsed), with
 //               tinyobjloader and with assimp, next to read() into memory (the floor);
 //   sequence  - per backend, the time of `snag check` on a whole sequence next to reading
-//               alone and checking alone, all with the same thread count;
+//               alone and checking alone, all with the same thread count, where the loop's
+//               thread spent its time, and the CPU time of each with the loop's floor (its
+//               CPU time over the machine's cores);
 //   memory    - the peak resident memory of `snag check` on a short and on a long sequence.
 // A benchmark, not a test: it prints the tables and fails only when something cannot run.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <assimp/Importer.hpp>
 
@@ -53,6 +56,29 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+/// CPU seconds the whole process has used so far, every thread's user and system time (those
+/// of threads already joined included). Spinning counts: OpenMP's idle workers, a CUDA sync.
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) { return t.tv_sec + t.tv_usec * 1e-6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+/// A phase's wall time and the CPU time the process spent in it, from construction to stop().
+class PhaseClock {
+ public:
+  struct Times {
+    double wall = 0;
+    double cpu = 0;
+  };
+  Times stop() const { return {seconds_since(wall_), process_cpu_seconds() - cpu_}; }
+
+ private:
+  Clock::time_point wall_ = Clock::now();
+  double cpu_ = process_cpu_seconds();
+};
 
 uint64_t total_bytes(const std::vector<fs::path>& files) {
   uint64_t bytes = 0;
@@ -241,10 +267,11 @@ void readers_table(const std::vector<ReaderCase>& cases, int passes) {
 
 struct SequenceRow {
   std::string backend;
-  double read = 0;   ///< seconds: every frame read by `threads` reader threads, nothing checked
-  double check = 0;  ///< seconds: every frame checked from memory
-  double both = 0;   ///< seconds: the frame loop of `snag check`, reports written
-  int readers = 0;   ///< reader threads `snag check` used
+  PhaseClock::Times read;   ///< every frame read by `threads` reader threads, nothing checked
+  PhaseClock::Times check;  ///< every frame checked from memory
+  PhaseClock::Times both;   ///< the frame loop of `snag check`, reports written
+  double reports_cpu = 0;   ///< CPU seconds of `both` in the report stream's threads
+  int readers = 0;          ///< reader threads `snag check` used
   int64_t pairs = 0;
   LoopTimes loop;  ///< where `snag check`'s loop spent `both`
 };
@@ -269,9 +296,9 @@ auto on_own_thread(F&& f) {
   return result;
 }
 
-/// Seconds to read every frame with `readers` threads, as `snag check` reads them.
-double time_reading(const std::vector<seq::Frame>& frames, int readers) {
-  const auto started = Clock::now();
+/// Reading every frame with `readers` threads, as `snag check` reads them.
+PhaseClock::Times time_reading(const std::vector<seq::Frame>& frames, int readers) {
+  const PhaseClock clock;
   std::vector<io::FrameReader> per_thread(static_cast<size_t>(readers));
   seq::FramePrefetcher prefetcher(frames, readers, 2 * readers,
                                   [&](const seq::Frame& f, int reader) {
@@ -279,12 +306,12 @@ double time_reading(const std::vector<seq::Frame>& frames, int readers) {
                                   });
   while (prefetcher.next()) {
   }
-  return seconds_since(started);
+  return clock.stop();
 }
 
-/// Seconds to check every frame from memory (read beforehand), each next frame staged.
-double time_checking(const std::vector<seq::Frame>& frames, const std::string& backend, int threads,
-                     int device, int64_t& pairs) {
+/// Checking every frame from memory (read beforehand), each next frame staged.
+PhaseClock::Times time_checking(const std::vector<seq::Frame>& frames, const std::string& backend,
+                                int threads, int device, int64_t& pairs) {
   std::vector<mesh::Mesh> meshes;
   io::FrameReader reader;
   for (const seq::Frame& f : frames) meshes.push_back(reader.read(f.path));
@@ -293,20 +320,21 @@ double time_checking(const std::vector<seq::Frame>& frames, const std::string& b
                          static_cast<int32_t>(meshes.front().positions.size()));
   checker->check(meshes.front().positions);  // warm-up: the first build, the buffers
   pairs = 0;
-  const auto started = Clock::now();
+  const PhaseClock clock;
   for (size_t i = 0; i < meshes.size(); ++i) {
     const std::span<const geom::Vec3d> next =
         i + 1 < meshes.size() ? std::span<const geom::Vec3d>(meshes[i + 1].positions)
                               : std::span<const geom::Vec3d>();
     pairs += static_cast<int64_t>(checker->check(meshes[i].positions, next).pairs.size());
   }
-  return seconds_since(started);
+  return clock.stop();
 }
 
-/// Seconds of `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
-double time_check_command(const std::vector<seq::Frame>& frames, const std::string& backend,
-                          int threads, int device, const fs::path& out, int& readers,
-                          int64_t& pairs, LoopTimes& loop) {
+/// `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
+PhaseClock::Times time_check_command(const std::vector<seq::Frame>& frames,
+                                     const std::string& backend, int threads, int device,
+                                     const fs::path& out, int& readers, int64_t& pairs,
+                                     LoopTimes& loop, double& reports_cpu) {
   const std::unique_ptr<detect::Checker> checker =
       make_bench_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   {  // warm-up, as for checking alone: the device and its buffers
@@ -319,7 +347,7 @@ double time_check_command(const std::vector<seq::Frame>& frames, const std::stri
   settings.gpu = checker->backend_name() == "cuda";
   settings.times = &loop;
   readers = readers_for(settings.threads, settings.gpu);
-  const auto started = Clock::now();
+  const PhaseClock clock;
   report::ReportStream stream(out, SNAG_VERSION, {}, {}, threads);
   report::Inputs inputs;
   check_sequence(
@@ -328,9 +356,10 @@ double time_check_command(const std::vector<seq::Frame>& frames, const std::stri
       [](const std::string&) {});
   const report::Summary summary =
       stream.finish(inputs, checker->build_count(), checker->rebuild_count(), 0);
-  const double seconds = seconds_since(started);
+  const PhaseClock::Times times = clock.stop();
   pairs = summary.pairs;
-  return seconds;
+  reports_cpu = stream.cpu_seconds();
+  return times;
 }
 
 void sequence_table(const std::string& name, const std::vector<seq::Frame>& frames,
@@ -347,7 +376,7 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
     int64_t pipeline_pairs = 0;
     row.both = on_own_thread([&] {
       return time_check_command(frames, backend, threads, device, scratch / backend, row.readers,
-                                pipeline_pairs, row.loop);
+                                pipeline_pairs, row.loop, row.reports_cpu);
     });
     if (pipeline_pairs != row.pairs)
       throw InternalError("bench io: snag check found " + std::to_string(pipeline_pairs) +
@@ -374,10 +403,10 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
   std::printf("%-8s %8s %9s %9s %11s %8s %10s %10s %8s\n", "backend", "readers", "read", "check",
               "snag check", "MB/s", "/ read", "/ larger", "pairs");
   for (const SequenceRow& r : rows) {
-    const double larger = std::max(r.read, r.check);
+    const double larger = std::max(r.read.wall, r.check.wall);
     std::printf("%-8s %8d %9.3f %9.3f %11.3f %8.0f %9.2fx %9.2fx %8lld\n", r.backend.c_str(),
-                r.readers, r.read, r.check, r.both, bytes / r.both / 1e6, r.both / r.read,
-                r.both / larger, static_cast<long long>(r.pairs));
+                r.readers, r.read.wall, r.check.wall, r.both.wall, bytes / r.both.wall / 1e6,
+                r.both.wall / r.read.wall, r.both.wall / larger, static_cast<long long>(r.pairs));
   }
   std::printf(
       "\nWhere snag check's loop spent its time (seconds on the loop's thread): waiting = for the\n"
@@ -392,8 +421,32 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
   for (const SequenceRow& r : rows)
     std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %9.3f %10.3f\n",
                 r.backend.c_str(), r.loop.waiting, r.loop.preparing, r.loop.checking,
-                r.loop.recording, r.loop.handing, r.loop.behind, r.both, r.loop.starting,
+                r.loop.recording, r.loop.handing, r.loop.behind, r.both.wall, r.loop.starting,
                 r.loop.comparing);
+
+  // The floor of the loop: it does at least its CPU work, and no schedule runs that on the
+  // machine's cores in less than work / cores. A target under the floor needs less work (or a
+  // cheaper kind of it), not more overlap.
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  std::printf(
+      "\nCPU seconds, every thread of the process (user and system, spinning included): "
+      "reading alone,\nchecking alone, snag check, of which the report stream's threads "
+      "(formatting and writing) and\nthe rest beyond reading, checking and reports (comparing, "
+      "preparing, recording, spinning);\nbusy = CPU / wall, the cores kept busy by reading alone "
+      "and by snag check; floor = snag\ncheck's CPU over this machine's %u cores, the least wall "
+      "time any schedule of it could take\n",
+      cores);
+  std::printf("%-8s %8s %8s %11s %8s %8s %10s %10s %8s %8s %9s\n", "backend", "read", "check",
+              "snag check", "reports", "rest", "read busy", "snag busy", "floor", "/ read",
+              "/ larger");
+  for (const SequenceRow& r : rows) {
+    const double floor = r.both.cpu / cores;
+    std::printf("%-8s %8.3f %8.3f %11.3f %8.3f %8.3f %10.1f %10.1f %8.3f %7.2fx %8.2fx\n",
+                r.backend.c_str(), r.read.cpu, r.check.cpu, r.both.cpu, r.reports_cpu,
+                r.both.cpu - r.read.cpu - r.check.cpu - r.reports_cpu, r.read.cpu / r.read.wall,
+                r.both.cpu / r.both.wall, floor, floor / r.read.wall,
+                floor / std::max(r.read.wall, r.check.wall));
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -362,33 +362,33 @@ std::vector<FrameRecord> random_frames(uint32_t seed, int count) {
 TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
   // One formatter, and as many as frames may wait (formatted side by side, written in order).
   for (int formatters : {1, static_cast<int>(ReportStream::write_ahead)})
-  for (uint32_t seed : {1u, 2u, 3u}) {
-    SCOPED_TRACE("seed=" + std::to_string(seed) + " formatters=" + std::to_string(formatters));
-    Settings settings = small_settings();
-    settings.weld = 1e-5;
-    settings.frames.reset();
-    settings.fail_on = seed == 2 ? FailOn::crossing : FailOn::none;
-    Inputs inputs = small_inputs();
-    inputs.ids = "assimp";
-    inputs.coincident_vertices = seed;
-    const std::vector<FrameRecord> frames = random_frames(seed, 60);
+    for (uint32_t seed : {1u, 2u, 3u}) {
+      SCOPED_TRACE("seed=" + std::to_string(seed) + " formatters=" + std::to_string(formatters));
+      Settings settings = small_settings();
+      settings.weld = 1e-5;
+      settings.frames.reset();
+      settings.fail_on = seed == 2 ? FailOn::crossing : FailOn::none;
+      Inputs inputs = small_inputs();
+      inputs.ids = "assimp";
+      inputs.coincident_vertices = seed;
+      const std::vector<FrameRecord> frames = random_frames(seed, 60);
 
-    TempDir tmp;
-    ReportStream stream(tmp.path(), "0.1.0", settings, {}, formatters);
-    for (const FrameRecord& f : frames) stream.add(f);
-    const Summary streamed = stream.finish(inputs, 3, 2, 12.25);
+      TempDir tmp;
+      ReportStream stream(tmp.path(), "0.1.0", settings, {}, formatters);
+      for (const FrameRecord& f : frames) stream.add(f);
+      const Summary streamed = stream.finish(inputs, 3, 2, 12.25);
 
-    const Report r = whole_report("0.1.0", settings, inputs, frames, 3, 2, 12.25);
-    std::ostringstream pairs, frames_csv;
-    write_pairs_csv(pairs, r);
-    write_frames_csv(frames_csv, r);
-    EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), pairs.str());
-    EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
-    const std::string json = read_all(tmp.path() / "report.json");
-    EXPECT_EQ(json, report_json(r));
-    EXPECT_TRUE(is_report_layout(json));
-    EXPECT_TRUE(streamed == summarize(r));
-  }
+      const Report r = whole_report("0.1.0", settings, inputs, frames, 3, 2, 12.25);
+      std::ostringstream pairs, frames_csv;
+      write_pairs_csv(pairs, r);
+      write_frames_csv(frames_csv, r);
+      EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), pairs.str());
+      EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
+      const std::string json = read_all(tmp.path() / "report.json");
+      EXPECT_EQ(json, report_json(r));
+      EXPECT_TRUE(is_report_layout(json));
+      EXPECT_TRUE(streamed == summarize(r));
+    }
 }
 
 /// A scene's objects whose names need CSV quoting, JSON escapes or hold UTF-8.
@@ -661,6 +661,30 @@ TEST(ReportStream, WithoutDirectoryKeepsTheSummaryOnly) {
   const Summary s = stream.finish(small_inputs(), 1, 0, 2.5);
   EXPECT_TRUE(s == summarize(whole_report("1.2.3", small_settings(), small_inputs(), small_frames(),
                                           1, 0, 2.5)));
+  EXPECT_EQ(stream.cpu_seconds(), 0.0);  // no threads
+}
+
+/// CPU seconds of every thread of this process so far (those joined included).
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) { return t.tv_sec + t.tv_usec * 1e-6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+TEST(ReportStream, CpuSecondsAreItsThreadsOnceFinished) {
+  const std::vector<FrameRecord> frames = random_frames(7, 200);
+  TempDir tmp;
+  const double process_before = process_cpu_seconds();
+  ReportStream stream(tmp.path(), "0.1.0", small_settings(), {}, 2);
+  for (const FrameRecord& f : frames) stream.add(f);
+  EXPECT_EQ(stream.cpu_seconds(), 0.0);  // counted as its threads end
+  stream.finish(small_inputs(), 1, 0, 1.0);
+  const double process = process_cpu_seconds() - process_before;
+  // Its threads formatted and wrote every frame: some CPU time, and no more than the whole
+  // process used meanwhile (getrusage rounds to microseconds, hence the slack).
+  EXPECT_GT(stream.cpu_seconds(), 0.0);
+  EXPECT_LE(stream.cpu_seconds(), process + 1e-3);
 }
 
 /// The summary recounted from scratch over frames[0, n): every count by walking the pairs, the

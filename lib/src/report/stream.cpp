@@ -1,5 +1,7 @@
 #include "snag/report/stream.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -18,6 +20,13 @@ namespace snag::report {
 namespace fs = std::filesystem;
 
 namespace {
+
+/// CPU seconds the calling thread has used.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
 
 /// Appends the scratch file `piece` to `out` in fixed-size chunks: a spool holds the whole
 /// run's records and is never read into memory at once.
@@ -102,7 +111,10 @@ void ReportStream::format_loop() {
   std::unique_lock lock(mutex_);
   for (;;) {
     handed_over_.wait(lock, [&] { return closing_ || taken_ < handed_; });
-    if (taken_ == handed_) return;  // closing, every frame taken
+    if (taken_ == handed_) {  // closing, every frame taken
+      cpu_seconds_ += thread_cpu_seconds();
+      return;
+    }
     // References into the deque stay valid while others are added or written: this frame
     // is neither written nor moved before it is marked formatted.
     Unwritten& entry = unwritten_[taken_ - unwritten_.front().sequence];

@@ -79,6 +79,11 @@ class ReportStream {
   /// The summary of the frames added so far (worst_frame counts them in the order added).
   const Summary& summary() const;
 
+  /// CPU seconds the stream's threads used formatting and writing the reports (the kernel's
+  /// copies into the page cache included), once finish() has returned; 0 before, and without
+  /// an output directory.
+  double cpu_seconds() const { return cpu_seconds_; }
+
   /// Ends the run with what is known only at its end: `inputs` (inputs.sequence, ids and the
   /// first frame's vertex counts; the files are the frames added; inputs.objects, the scene's
   /// objects as report.json lists them), the tree builds and rebuilds, and the run's
@@ -131,6 +136,7 @@ class ReportStream {
   bool closing_ = false;
   std::exception_ptr write_error_;
   std::vector<std::thread> formatters_;
+  double cpu_seconds_ = 0;  ///< each formatter thread's CPU time, added as it ends
 };
 
 }  // namespace snag::report
