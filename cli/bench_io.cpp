@@ -12,7 +12,6 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fcntl.h>
-#include <sys/resource.h>
 #include <unistd.h>
 #include <assimp/Importer.hpp>
 
@@ -39,6 +38,7 @@
 #include "bench_support.h"
 #include "check_sequence.h"
 #include "commands.h"
+#include "snag/cpu_time.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/report/stream.h"
@@ -55,15 +55,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// CPU seconds the whole process has used so far, every thread's user and system time (those
-/// of threads already joined included). Spinning counts: OpenMP's idle workers, a CUDA sync.
-double process_cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& t) { return t.tv_sec + t.tv_usec * 1e-6; };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 /// A phase's wall time and the CPU time the process spent in it, from construction to stop().
@@ -331,10 +322,18 @@ PhaseClock::Times time_checking(const std::vector<seq::Frame>& frames, const std
 }
 
 /// `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
-PhaseClock::Times time_check_command(const std::vector<seq::Frame>& frames,
-                                     const std::string& backend, int threads, int device,
-                                     const fs::path& out, int& readers, int64_t& pairs,
-                                     LoopTimes& loop, double& reports_cpu) {
+struct CheckCommandRun {
+  PhaseClock::Times times;
+  int readers = 0;         ///< reader threads it used
+  int64_t pairs = 0;       ///< over every frame
+  LoopTimes loop;          ///< where its loop's thread spent the time
+  double reports_cpu = 0;  ///< CPU seconds in the report stream's own threads
+};
+
+CheckCommandRun time_check_command(const std::vector<seq::Frame>& frames,
+                                   const std::string& backend, int threads, int device,
+                                   const fs::path& out) {
+  CheckCommandRun run;
   const std::unique_ptr<detect::Checker> checker =
       make_bench_checker(backend, checker_threads_for(threads, backend == "cuda"), device);
   {  // warm-up, as for checking alone: the device and its buffers
@@ -345,8 +344,8 @@ PhaseClock::Times time_check_command(const std::vector<seq::Frame>& frames,
   SequenceSettings settings;
   settings.threads = threads;
   settings.gpu = checker->backend_name() == "cuda";
-  settings.times = &loop;
-  readers = readers_for(settings.threads, settings.gpu);
+  settings.times = &run.loop;
+  run.readers = readers_for(settings.threads, settings.gpu);
   const PhaseClock clock;
   report::ReportStream stream(out, SNAG_VERSION, {}, {}, threads);
   report::Inputs inputs;
@@ -356,10 +355,10 @@ PhaseClock::Times time_check_command(const std::vector<seq::Frame>& frames,
       [](const std::string&) {});
   const report::Summary summary =
       stream.finish(inputs, checker->build_count(), checker->rebuild_count(), 0);
-  const PhaseClock::Times times = clock.stop();
-  pairs = summary.pairs;
-  reports_cpu = stream.cpu_seconds();
-  return times;
+  run.times = clock.stop();
+  run.pairs = summary.pairs;
+  run.reports_cpu = stream.cpu_seconds();
+  return run;
 }
 
 void sequence_table(const std::string& name, const std::vector<seq::Frame>& frames,
@@ -373,14 +372,15 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
     row.read = time_reading(frames, threads);
     row.check =
         on_own_thread([&] { return time_checking(frames, backend, threads, device, row.pairs); });
-    int64_t pipeline_pairs = 0;
-    row.both = on_own_thread([&] {
-      return time_check_command(frames, backend, threads, device, scratch / backend, row.readers,
-                                pipeline_pairs, row.loop, row.reports_cpu);
-    });
-    if (pipeline_pairs != row.pairs)
-      throw InternalError("bench io: snag check found " + std::to_string(pipeline_pairs) +
+    const CheckCommandRun run = on_own_thread(
+        [&] { return time_check_command(frames, backend, threads, device, scratch / backend); });
+    if (run.pairs != row.pairs)
+      throw InternalError("bench io: snag check found " + std::to_string(run.pairs) +
                           " pairs, checking from memory " + std::to_string(row.pairs));
+    row.both = run.times;
+    row.readers = run.readers;
+    row.loop = run.loop;
+    row.reports_cpu = run.reports_cpu;
     // The loop's reports (~0.25 MB a frame of this cloth) are still being written back from the
     // page cache: not in the next row's times.
     ::sync();
@@ -424,23 +424,28 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
                 r.loop.recording, r.loop.handing, r.loop.behind, r.both.wall, r.loop.starting,
                 r.loop.comparing);
 
-  // The floor of the loop: it does at least its CPU work, and no schedule runs that on the
-  // machine's cores in less than work / cores. A target under the floor needs less work (or a
-  // cheaper kind of it), not more overlap.
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  // The loop's floor: a schedule that spends the loop's CPU time on the machine's logical CPUs
+  // takes at least that time over their count. Spinning and contention are in the CPU time
+  // (the same work costs more CPU with more threads), so the floor of the work a loop must do
+  // may be lower; still, a target far under the floor needs the loop to spend less, not to
+  // overlap more.
+  const unsigned cpus = std::max(1u, std::thread::hardware_concurrency());
   std::printf(
       "\nCPU seconds, every thread of the process (user and system, spinning included): "
-      "reading alone,\nchecking alone, snag check, of which the report stream's threads "
-      "(formatting and writing) and\nthe rest beyond reading, checking and reports (comparing, "
-      "preparing, recording, spinning);\nbusy = CPU / wall, the cores kept busy by reading alone "
-      "and by snag check; floor = snag\ncheck's CPU over this machine's %u cores, the least wall "
-      "time any schedule of it could take\n",
-      cores);
+      "reading alone,\nchecking alone, snag check, of which reports = the report stream's own "
+      "threads (formatting,\nwriting) and rest = what is left beyond reading, checking and "
+      "reports (comparing, preparing,\nrecording, spinning, and the difference between the "
+      "loop's readers and checker threads and\nthose of reading and checking alone); busy = "
+      "CPU / wall, the CPUs kept busy by reading alone\nand by snag check; floor = snag check's "
+      "CPU over this machine's %u logical CPUs, the least wall\ntime of any schedule that "
+      "spends as much CPU; / read, / larger = the floor over reading alone's\nwall time and "
+      "over the larger of reading's and checking's\n",
+      cpus);
   std::printf("%-8s %8s %8s %11s %8s %8s %10s %10s %8s %8s %9s\n", "backend", "read", "check",
               "snag check", "reports", "rest", "read busy", "snag busy", "floor", "/ read",
               "/ larger");
   for (const SequenceRow& r : rows) {
-    const double floor = r.both.cpu / cores;
+    const double floor = r.both.cpu / cpus;
     std::printf("%-8s %8.3f %8.3f %11.3f %8.3f %8.3f %10.1f %10.1f %8.3f %7.2fx %8.2fx\n",
                 r.backend.c_str(), r.read.cpu, r.check.cpu, r.both.cpu, r.reports_cpu,
                 r.both.cpu - r.read.cpu - r.check.cpu - r.reports_cpu, r.read.cpu / r.read.wall,

@@ -1,7 +1,5 @@
 #include "snag/report/stream.h"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -10,6 +8,7 @@
 #include <vector>
 
 #include "json_layout.h"
+#include "snag/cpu_time.h"
 #include "snag/error.h"
 #include "snag/report/csv.h"
 #include "snag/report/write.h"
@@ -20,13 +19,6 @@ namespace snag::report {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// CPU seconds the calling thread has used.
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
-}
 
 /// Appends the scratch file `piece` to `out` in fixed-size chunks: a spool holds the whole
 /// run's records and is never read into memory at once.
