@@ -45,9 +45,15 @@ struct SequenceSettings {
 std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
                                    const scene::SceneFrame& frame);
 
-/// Reader threads for a run with `threads` workers. On the CPU a frame's reading costs about
-/// a fifteenth of its check on one thread (36K triangles: 1-2 ms against 15-30 ms), so one
-/// reader per 16 threads keeps ahead of the checker (at least 1, at most 4); on a GPU the host
+/// Reader threads for a run with `threads` workers. On the CPU a frame's reading costs a
+/// seventh to a twelfth of its check (36K triangles read in sequence on the H100's host: ~2 ms
+/// of one CPU, against ~12 ms of checking for a frame with no pairs and 19-25 ms for one folded
+/// through itself), so one reader per 8 threads keeps ahead of the checker (at least 1, at most
+/// 4). 1,000 frames at 16 threads, two runs each (snag check's wall time, 13 workers and 2
+/// readers against 14 and 1): 1.07-1.31 s against 1.97-2.17 on frames with no pairs, where one
+/// reader could not keep up; 1.71-1.94 against 1.94-2.10 on folded ones. At 8 threads 2 readers
+/// gained little on the first (1.74-1.99 against 1.93-2.02 s) and lost some on the second
+/// (2.53-3.05 against 2.63-2.66), so one reader stays there. On a GPU the host
 /// mostly waits, reading is the work, and every thread reads, the checker's on top (it mostly
 /// waits for the device: on the H100's host, 200 frames of 36K triangles, snag check took
 /// 0.124-0.134 s with 3 readers at 4 threads, 0.088-0.092 with 4; 0.064-0.079 with 7 at 8,
@@ -73,7 +79,8 @@ constexpr int kMostFramesAhead = 4096;  ///< however small the frames
 /// were starved in turn. 16 cores of the H100 host, 200 frames of 36K triangles, snag check
 /// against checking alone on 16 threads: 2.05 times with 16 workers and a reader on top, 1.45
 /// with 12 workers and 4 readers, 1.26 with 14 and 2, 1.21 with 15 and 1 (whose loop checked
-/// as fast as the check alone). From 16 threads one more core in 16 is left to the preparing
+/// as fast as the check alone; at 7505b01, whose checks were slower: one reader then kept up
+/// with them, see readers_for). From 16 threads one more core in 16 is left to the preparing
 /// thread and the report stream's formatters, whose frames otherwise waited for a core while
 /// the workers spun: snag check 0.49-0.58 s with 15 workers, 0.41-0.52 with 14, four runs each
 /// (the same host, checking alone 0.27-0.43; with 14 the loop's wait to hand a frame to the
