@@ -462,7 +462,7 @@ std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
 
 int readers_for(int threads, bool gpu) {
   threads = std::max(threads, 1);
-  return gpu ? threads : std::clamp(threads / 8, 1, 4);
+  return gpu ? std::min(threads, std::max(8, threads / 2)) : std::clamp(threads / 8, 1, 4);
 }
 
 int frames_ahead_for(int readers, bool gpu, uint64_t frame_file_bytes) {

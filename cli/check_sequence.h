@@ -53,12 +53,16 @@ std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
 /// readers against 14 and 1): 1.07-1.31 s against 1.97-2.17 on frames with no pairs, where one
 /// reader could not keep up; 1.71-1.94 against 1.94-2.10 on folded ones. At 8 threads 2 readers
 /// gained little on the first (1.74-1.99 against 1.93-2.02 s) and lost some on the second
-/// (2.53-3.05 against 2.63-2.66), so one reader stays there. On a GPU the host
-/// mostly waits, reading is the work, and every thread reads, the checker's on top (it mostly
-/// waits for the device: on the H100's host, 200 frames of 36K triangles, snag check took
-/// 0.124-0.134 s with 3 readers at 4 threads, 0.088-0.092 with 4; 0.064-0.079 with 7 at 8,
-/// 0.055-0.067 with 8). Readers wait whenever the frames ahead fill their ring
-/// (frames_ahead_for).
+/// (2.53-3.05 against 2.63-2.66), so one reader stays there. On a GPU reading is most of the
+/// host's work: up to 8 threads every thread reads, the checker's on top (on the H100's host,
+/// 200 frames of 36K triangles, snag check took 0.124-0.134 s with 3 readers at 4 threads,
+/// 0.088-0.092 with 4; 0.064-0.079 with 7 at 8, 0.055-0.067 with 8). From 8 threads on, half
+/// of them read (at least 8): readers on every CPU starve the loop's own threads (the check,
+/// the comparing, the recording, the report's formatters), whose work is serial. 1,000 frames
+/// at 16 threads, three runs each, the loop's seconds: 0.68-0.86 with 16 readers, 0.62-0.84
+/// with 14, 0.67-0.84 with 12, 0.50-0.77 with 8 on frames folded through themselves;
+/// 0.62-0.71, 0.42-0.60, 0.43-0.60 and 0.49-0.51 on frames with no pairs. Readers wait
+/// whenever the frames ahead fill their ring (frames_ahead_for).
 int readers_for(int threads, bool gpu);
 
 /// Frames the readers may hold ahead of the loop (read, or being read, not yet taken), for
