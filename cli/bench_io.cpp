@@ -397,9 +397,11 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
       "read = %d reader threads, nothing checked; check = every frame from memory; snag "
       "check = its frame\nloop (reading ahead on its reader threads, checking, writing the "
       "reports; %d threads in all on the\nCPU from 8 threads, readers on top below and on the "
-      "GPU); target: snag check within 10%% of the\nlarger of read and check on the CPU, of "
-      "read on the GPU\n",
-      threads, threads);
+      "GPU); readers = snag check's reader threads\n(read alone uses %d); MB/s = the "
+      "sequence's bytes over snag check's time; / read, / larger =\nsnag check over read and "
+      "over the larger of read and check; target: snag check within 10%% of\nthe larger of "
+      "read and check on the CPU, of read on the GPU\n",
+      threads, threads, threads);
   std::printf("%-8s %8s %9s %9s %11s %8s %10s %10s %8s\n", "backend", "readers", "read", "check",
               "snag check", "MB/s", "/ read", "/ larger", "pairs");
   for (const SequenceRow& r : rows) {
