@@ -45,26 +45,24 @@ struct SequenceSettings {
 std::vector<uint8_t> moved_between(const scene::SceneFrame& previous,
                                    const scene::SceneFrame& frame);
 
-/// Reader threads for a run of `threads` threads (--threads). On the CPU a frame's reading costs
-/// a sixth to a twelfth of its check (36K triangles read in sequence on the H100's host: ~2 ms
-/// of one CPU, against ~12 ms of checking for a frame with no pairs and 19-25 ms for one folded
-/// through itself), so one reader per 8 threads (at least 1, at most 4) keeps ahead of the
-/// checker at 16 threads; at 8, frames with no pairs want ~1.2 readers' worth, and neither one
-/// nor two keeps up with both kinds. 1,000 frames at 16 threads, two runs each (the process's
-/// wall time, 13 workers and 2
-/// readers against 14 and 1): 1.07-1.31 s against 1.97-2.17 on frames with no pairs, where one
-/// reader could not keep up; 1.71-1.94 against 1.94-2.10 on folded ones. At 8 threads 2 readers
+/// Reader threads for a run of `threads` threads (--threads). On the CPU a frame's reading costs a
+/// sixth to a twelfth of its check (36K triangles read in sequence on the H100's host: ~2 ms of one
+/// CPU, against ~12 ms of checking for a frame with no pairs and 19-25 ms for one folded through
+/// itself), so one reader per 8 threads (at least 1, at most 4) keeps ahead of the checker at 16
+/// threads; at 8, frames with no pairs want ~1.2 readers' worth, and neither one nor two keeps up
+/// with both kinds. 1,000 frames at 16 threads, two runs each (the process's wall time, 13 workers
+/// and 2 readers against 14 and 1): 1.07-1.31 s against 1.97-2.17 on frames with no pairs, where
+/// one reader could not keep up; 1.71-1.94 against 1.94-2.10 on folded ones. At 8 threads 2 readers
 /// gained little on the first (1.74-1.99 against 1.93-2.02 s) and lost some on the second
-/// (2.53-3.05 against 2.63-2.66), so one reader stays there. On a GPU reading is most of the
-/// host's work: up to 8 threads every thread reads, the checker's on top (on the H100's host,
-/// 200 frames of 36K triangles, snag check took 0.124-0.134 s with 3 readers at 4 threads,
-/// 0.088-0.092 with 4; 0.064-0.079 with 7 at 8, 0.055-0.067 with 8). Beyond 8 threads
-/// min(threads, max(8, threads / 2)) read (8 from 8 to 16 threads, half beyond): readers on
-/// every CPU starve the loop's own threads (the check, the comparing, the recording, the
-/// report's formatters), whose work is serial. 1,000 frames at 16 threads, three runs each,
-/// snag check's summary "in all" seconds: 0.68-0.86 with 16 readers, 0.62-0.84
-/// with 14, 0.67-0.84 with 12, 0.50-0.77 with 8 on frames folded through themselves;
-/// 0.62-0.71, 0.42-0.60, 0.43-0.60 and 0.49-0.51 on frames with no pairs. Readers wait
+/// (2.53-3.05 against 2.63-2.66), so one reader stays there. On a GPU reading is most of the host's
+/// work: up to 8 threads every thread reads, the checker's on top (on the H100's host, 200 frames
+/// of 36K triangles, snag check took 0.124-0.134 s with 3 readers at 4 threads, 0.088-0.092 with 4;
+/// 0.064-0.079 with 7 at 8, 0.055-0.067 with 8). Beyond 8 threads min(threads, max(8, threads / 2))
+/// read (8 from 8 to 16 threads, half beyond): readers on every CPU starve the loop's own threads
+/// (the check, the comparing, the recording, the report's formatters), whose work is serial. 1,000
+/// frames at 16 threads, three runs each, snag check's summary "in all" seconds: 0.68-0.86 with 16
+/// readers, 0.62-0.84 with 14, 0.67-0.84 with 12, 0.50-0.77 with 8 on frames folded through
+/// themselves; 0.62-0.71, 0.42-0.60, 0.43-0.60 and 0.49-0.51 on frames with no pairs. Readers wait
 /// whenever the frames ahead fill their ring (frames_ahead_for).
 int readers_for(int threads, bool gpu);
 
@@ -81,20 +79,20 @@ constexpr uint64_t kReadAheadBytes = uint64_t{256} << 20;
 constexpr int kMostFramesAhead = 4096;  ///< however small the frames
 
 /// The checker's worker threads in a run of `threads`. On the CPU with 8 threads or more, the
-/// readers' threads are taken out, so that the run stays within `threads`: OpenMP's workers
-/// spin between parallel regions, and readers that took their cores stalled the regions and
-/// were starved in turn. 16 logical CPUs of the H100 host, 200 frames of 36K triangles, snag check
-/// against checking alone on 16 threads at 7505b01: 2.05 times with 16 workers and a reader on
-/// top, 1.45 with 12 workers and 4 readers, 1.26 with 14 and 2, 1.21 with 15 and 1 (whose loop
-/// checked as fast as the check alone: checks were slower then, and one reader kept up with them;
-/// now two do, see readers_for). So now 16 threads give 13 workers, 2 readers and 1 left over; 8
-/// give 7 and 1. From 16 threads one more CPU in 16 is left to the preparing
-/// thread and the report stream's formatters, whose frames otherwise waited for a core while
-/// the workers spun: snag check 0.49-0.58 s with 15 workers, 0.41-0.52 with 14, four runs each
-/// (the same host, checking alone 0.27-0.43; with 14 the loop's wait to hand a frame to the
-/// report stream 0.001-0.06 s where it was 0.09-0.10). Below 8 threads, where a reader's CPU
-/// would be a seventh to a half of the check's, and on a GPU, whose checker uses its CPU threads
-/// only for the exact stage, the readers come on top and the checker has all `threads`.
+/// readers' threads are taken out, so that the run stays within `threads`: OpenMP's workers spin
+/// between parallel regions, and readers that took their cores stalled the regions and were starved
+/// in turn. 16 logical CPUs of the H100 host, 200 frames of 36K triangles, snag check against
+/// checking alone on 16 threads at 7505b01: 2.05 times with 16 workers and a reader on top, 1.45
+/// with 12 workers and 4 readers, 1.26 with 14 and 2, 1.21 with 15 and 1 (whose loop checked as
+/// fast as the check alone: checks were slower then, and one reader kept up with them; now two do,
+/// see readers_for). So now 16 threads give 13 workers, 2 readers and 1 left over; 8 give 7 and 1.
+/// From 16 threads one more CPU in 16 is left to the preparing thread and the report stream's
+/// formatters, whose frames otherwise waited for a core while the workers spun: snag check
+/// 0.49-0.58 s with 15 workers, 0.41-0.52 with 14, four runs each (the same host, checking alone
+/// 0.27-0.43; with 14 the loop's wait to hand a frame to the report stream 0.001-0.06 s where it
+/// was 0.09-0.10). Below 8 threads, where a reader's CPU would be a seventh to a half of the
+/// check's, and on a GPU, whose checker uses its CPU threads only for the exact stage, the readers
+/// come on top and the checker has all `threads`.
 int checker_threads_for(int threads, bool gpu);
 
 /// Reads `frames` ahead and checks them in order with `checker`:
