@@ -362,6 +362,34 @@ std::vector<FrameRecord> random_frames(uint32_t seed, int count) {
   return frames;
 }
 
+/// What a test's stream and the whole-report writers made of the same frames.
+struct StreamedAndWhole {
+  Summary streamed;
+  Report whole;
+};
+
+/// Streams `frames` into `dir` with `formatters` threads and writes them whole with the
+/// report writers (builds 3, rebuilds 2, 12.25 s): the three files and the summaries must be
+/// the same.
+StreamedAndWhole expect_streamed_as_whole(const fs::path& dir, const Settings& settings,
+                                          const Inputs& inputs,
+                                          const std::vector<FrameRecord>& frames, int formatters) {
+  ReportStream stream(dir, "0.1.0", settings, inputs.objects, formatters);
+  for (const FrameRecord& f : frames) stream.add(f);
+  StreamedAndWhole run{stream.finish(inputs, 3, 2, 12.25),
+                       whole_report("0.1.0", settings, inputs, frames, 3, 2, 12.25)};
+  std::ostringstream pairs, frames_csv;
+  write_pairs_csv(pairs, run.whole);
+  write_frames_csv(frames_csv, run.whole);
+  EXPECT_EQ(read_all(dir / "pairs.csv"), pairs.str());
+  EXPECT_EQ(read_all(dir / "frames.csv"), frames_csv.str());
+  const std::string json = read_all(dir / "report.json");
+  EXPECT_EQ(json, report_json(run.whole));
+  EXPECT_TRUE(is_report_layout(json));
+  EXPECT_TRUE(run.streamed == summarize(run.whole));
+  return run;
+}
+
 TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
   // One formatter, and as many as frames may wait (formatted side by side, written in order).
   for (int formatters : {1, static_cast<int>(ReportStream::write_ahead)})
@@ -374,23 +402,8 @@ TEST(ReportStream, RandomRunMatchesTheWholeReportWriters) {
       Inputs inputs = small_inputs();
       inputs.ids = "assimp";
       inputs.coincident_vertices = seed;
-      const std::vector<FrameRecord> frames = random_frames(seed, 60);
-
-      TempDir tmp;
-      ReportStream stream(tmp.path(), "0.1.0", settings, {}, formatters);
-      for (const FrameRecord& f : frames) stream.add(f);
-      const Summary streamed = stream.finish(inputs, 3, 2, 12.25);
-
-      const Report r = whole_report("0.1.0", settings, inputs, frames, 3, 2, 12.25);
-      std::ostringstream pairs, frames_csv;
-      write_pairs_csv(pairs, r);
-      write_frames_csv(frames_csv, r);
-      EXPECT_EQ(read_all(tmp.path() / "pairs.csv"), pairs.str());
-      EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
-      const std::string json = read_all(tmp.path() / "report.json");
-      EXPECT_EQ(json, report_json(r));
-      EXPECT_TRUE(is_report_layout(json));
-      EXPECT_TRUE(streamed == summarize(r));
+      const TempDir tmp;
+      expect_streamed_as_whole(tmp.path(), settings, inputs, random_frames(seed, 60), formatters);
     }
 }
 
@@ -452,25 +465,12 @@ TEST(ReportStream, SceneRunMatchesTheWholeReportWriters) {
     inputs.objects = scene_objects();
     const std::vector<FrameRecord> frames = random_scene_frames(seed, 40, inputs.objects);
 
-    TempDir tmp;  // frames formatted side by side
-    ReportStream stream(tmp.path(), "0.1.0", settings, inputs.objects,
-                        static_cast<int>(ReportStream::write_ahead));
-    for (const FrameRecord& f : frames) stream.add(f);
-    const Summary streamed = stream.finish(inputs, 5, 1, 3.75);
-
-    const Report r = whole_report("0.1.0", settings, inputs, frames, 5, 1, 3.75);
-    std::ostringstream pairs, frames_csv;
-    write_pairs_csv(pairs, r);
-    write_frames_csv(frames_csv, r);
+    const TempDir tmp;  // frames formatted side by side
+    const auto [streamed, r] = expect_streamed_as_whole(
+        tmp.path(), settings, inputs, frames, static_cast<int>(ReportStream::write_ahead));
     const std::string streamed_pairs = read_all(tmp.path() / "pairs.csv");
-    EXPECT_EQ(streamed_pairs, pairs.str());
-    EXPECT_EQ(read_all(tmp.path() / "frames.csv"), frames_csv.str());
     EXPECT_EQ(streamed_pairs.substr(0, streamed_pairs.find('\n')), scene_pairs_csv_header);
-    const std::string json = read_all(tmp.path() / "report.json");
-    EXPECT_EQ(json, report_json(r));
-    EXPECT_TRUE(is_report_layout(json));
-    EXPECT_TRUE(streamed == summarize(r));
-    const auto parsed = nlohmann::json::parse(json);
+    const auto parsed = nlohmann::json::parse(read_all(tmp.path() / "report.json"));
     EXPECT_EQ(parsed.at("inputs").at("objects").size(), 4u);
     EXPECT_EQ(parsed.at("inputs").at("objects").at(3).at("name"), "dr\xc3\xa9pe\nfloor");
     EXPECT_EQ(parsed.at("summary").at("reused_pairs"), streamed.reused_pairs);
