@@ -256,15 +256,23 @@ void readers_table(const std::vector<ReaderCase>& cases, int passes) {
 // ---------------------------------------------------------------------------------------------
 // A whole sequence: `snag check` next to reading alone and checking alone.
 
+/// `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
+struct CheckCommandRun {
+  PhaseClock::Times times;
+  int readers = 0;         ///< reader threads it used
+  int64_t pairs = 0;       ///< over every frame
+  LoopTimes loop;          ///< where its loop's thread spent the time
+  double reports_cpu = 0;  ///< CPU seconds in the report stream's own threads
+};
+
 struct SequenceRow {
   std::string backend;
   PhaseClock::Times read;   ///< every frame read by `threads` reader threads, nothing checked
   PhaseClock::Times check;  ///< every frame checked from memory
-  PhaseClock::Times both;   ///< the frame loop of `snag check`, reports written
-  double reports_cpu = 0;   ///< CPU seconds of `both` in the report stream's threads
-  int readers = 0;          ///< reader threads `snag check` used
-  int64_t pairs = 0;
-  LoopTimes loop;  ///< where `snag check`'s loop spent `both`
+  int64_t pairs = 0;        ///< checking from memory found
+  CheckCommandRun both;     ///< the frame loop of `snag check`, reports written
+
+  double larger_wall() const { return std::max(read.wall, check.wall); }
 };
 
 /// f() on a thread of its own, its exception rethrown here. Checking alone and the check
@@ -321,15 +329,6 @@ PhaseClock::Times time_checking(const std::vector<seq::Frame>& frames, const std
   return clock.stop();
 }
 
-/// `snag check`'s frame loop (reading ahead, checking, writing reports into `out`).
-struct CheckCommandRun {
-  PhaseClock::Times times;
-  int readers = 0;         ///< reader threads it used
-  int64_t pairs = 0;       ///< over every frame
-  LoopTimes loop;          ///< where its loop's thread spent the time
-  double reports_cpu = 0;  ///< CPU seconds in the report stream's own threads
-};
-
 CheckCommandRun time_check_command(const std::vector<seq::Frame>& frames,
                                    const std::string& backend, int threads, int device,
                                    const fs::path& out) {
@@ -372,15 +371,11 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
     row.read = time_reading(frames, threads);
     row.check =
         on_own_thread([&] { return time_checking(frames, backend, threads, device, row.pairs); });
-    const CheckCommandRun run = on_own_thread(
+    row.both = on_own_thread(
         [&] { return time_check_command(frames, backend, threads, device, scratch / backend); });
-    if (run.pairs != row.pairs)
-      throw InternalError("bench io: snag check found " + std::to_string(run.pairs) +
+    if (row.both.pairs != row.pairs)
+      throw InternalError("bench io: snag check found " + std::to_string(row.both.pairs) +
                           " pairs, checking from memory " + std::to_string(row.pairs));
-    row.both = run.times;
-    row.readers = run.readers;
-    row.loop = run.loop;
-    row.reports_cpu = run.reports_cpu;
     // The loop's reports (~0.25 MB a frame of this cloth) are still being written back from the
     // page cache: not in the next row's times.
     ::sync();
@@ -405,10 +400,11 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
   std::printf("%-8s %8s %9s %9s %11s %8s %10s %10s %8s\n", "backend", "readers", "read", "check",
               "snag check", "MB/s", "/ read", "/ larger", "pairs");
   for (const SequenceRow& r : rows) {
-    const double larger = std::max(r.read.wall, r.check.wall);
+    const PhaseClock::Times& both = r.both.times;
     std::printf("%-8s %8d %9.3f %9.3f %11.3f %8.0f %9.2fx %9.2fx %8lld\n", r.backend.c_str(),
-                r.readers, r.read.wall, r.check.wall, r.both.wall, bytes / r.both.wall / 1e6,
-                r.both.wall / r.read.wall, r.both.wall / larger, static_cast<long long>(r.pairs));
+                r.both.readers, r.read.wall, r.check.wall, both.wall, bytes / both.wall / 1e6,
+                both.wall / r.read.wall, both.wall / r.larger_wall(),
+                static_cast<long long>(r.pairs));
   }
   std::printf(
       "\nWhere snag check's loop spent its time (seconds on the loop's thread): waiting = for the\n"
@@ -420,11 +416,12 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
       "frame's faces and positions\nagainst the frame before's\n");
   std::printf("%-8s %9s %10s %9s %10s %9s %9s %9s %9s %10s\n", "backend", "waiting", "preparing",
               "checking", "recording", "handing", "behind", "loop", "starting", "comparing");
-  for (const SequenceRow& r : rows)
+  for (const SequenceRow& r : rows) {
+    const LoopTimes& loop = r.both.loop;
     std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %9.3f %10.3f\n",
-                r.backend.c_str(), r.loop.waiting, r.loop.preparing, r.loop.checking,
-                r.loop.recording, r.loop.handing, r.loop.behind, r.both.wall, r.loop.starting,
-                r.loop.comparing);
+                r.backend.c_str(), loop.waiting, loop.preparing, loop.checking, loop.recording,
+                loop.handing, loop.behind, r.both.times.wall, loop.starting, loop.comparing);
+  }
 
   // The loop's floor: a schedule that spends the loop's CPU time on the machine's logical CPUs
   // takes at least that time over their count. Spinning and contention are in the CPU time
@@ -447,12 +444,12 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
               "snag check", "reports", "rest", "read busy", "snag busy", "floor", "/ read",
               "/ larger");
   for (const SequenceRow& r : rows) {
-    const double floor = r.both.cpu / cpus;
+    const PhaseClock::Times& both = r.both.times;
+    const double floor = both.cpu / cpus;
     std::printf("%-8s %8.3f %8.3f %11.3f %8.3f %8.3f %10.1f %10.1f %8.3f %7.2fx %8.2fx\n",
-                r.backend.c_str(), r.read.cpu, r.check.cpu, r.both.cpu, r.reports_cpu,
-                r.both.cpu - r.read.cpu - r.check.cpu - r.reports_cpu, r.read.cpu / r.read.wall,
-                r.both.cpu / r.both.wall, floor, floor / r.read.wall,
-                floor / std::max(r.read.wall, r.check.wall));
+                r.backend.c_str(), r.read.cpu, r.check.cpu, both.cpu, r.both.reports_cpu,
+                both.cpu - r.read.cpu - r.check.cpu - r.both.reports_cpu, r.read.cpu / r.read.wall,
+                both.cpu / both.wall, floor, floor / r.read.wall, floor / r.larger_wall());
   }
 }
 
