@@ -1,9 +1,7 @@
 // OBJ parsing from one in-memory buffer: one pass, no per-line allocation, numbers through
-// fast_float and std::from_chars. Only `v`, `f`, `o` and `g` are looked at; every other line
-// costs one memchr to find its end.
+// detail::parse_double (fast_float behind a fast path) and detail::parse_integer. Only `v`,
+// `f`, `o` and `g` are looked at; every other line costs one memchr to find its end.
 #include "snag/io/obj_reader.h"
-
-#include <fast_float/fast_float.h>
 
 #include <charconv>
 #include <cmath>
@@ -148,7 +146,7 @@ class ObjParser {
       }
       const char* start = p_;
       const char* first = detail::past_plus(p_, end_);
-      auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[k]);
+      auto [ptr, ec] = detail::parse_double(first, end_, xyz[k]);
       if (ec != std::errc() || ptr == first || !detail::ends_token(ptr, end_)) {
         fail("expected a number for the vertex's " + std::string(1, "xyz"[k]) +
              " coordinate, found " + quote_token(start, end_));

@@ -5,8 +5,6 @@
 // host's.
 #include "snag/io/ply_reader.h"
 
-#include <fast_float/fast_float.h>
-
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -714,7 +712,7 @@ class AsciiBody {
       // The number is parsed straight from the text and must end its token, so that each
       // character is read once.
       const char* first = detail::past_plus(start, end_);
-      auto [ptr, ec] = fast_float::from_chars(first, end_, xyz[axis]);
+      auto [ptr, ec] = detail::parse_double(first, end_, xyz[axis]);
       if (ec != std::errc() || ptr == first || !detail::ends_token(ptr, end_)) {
         fail(std::string("expected a number for the ") + "xyz"[axis] + " coordinate of " +
              record_name(el, i) + ", found " + quote_token(start, end_));
