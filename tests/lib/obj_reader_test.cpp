@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 
 #include "snag/error.h"
@@ -87,6 +88,57 @@ TEST(ObjReader, AllCornerForms) {
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {1, 3, 2}, {0, 1, 2}, {1, 3, 2}}));
   EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1, 2, 3}));
   EXPECT_EQ(m.polygon_count, 4);
+}
+
+// Faces written every way a file may write them, mixed at random (plain "f a b c", extra
+// spaces, tabs, CRLF, /vt/vn suffixes, relative and zero-padded indices, trailing comments,
+// quads, faces naming later vertices, groups between them): the triangles, polygons and groups
+// read are the ones written, whichever of the reader's paths each line took.
+TEST(ObjReader, FacesWrittenEveryWayGiveTheTrianglesWritten) {
+  std::mt19937 rng(1124);
+  const int vertices = 60;
+  std::string text;
+  for (int v = 0; v < vertices / 2; ++v) text += "v " + std::to_string(v) + " 0 1\n";
+  Tris expected;
+  std::vector<int32_t> polygons, groups;
+  int32_t polygon = 0, group = -1;
+  std::uniform_int_distribution<int> vertex(0, vertices - 1), form(0, 9);
+  for (int f = 0; f < 3000; ++f) {
+    if (f == 1500)  // the rest of the vertices, after half the faces
+      for (int v = vertices / 2; v < vertices; ++v) text += "v " + std::to_string(v) + " 0 1\n";
+    if (form(rng) == 0) {
+      group = group + 1;
+      text += "g part" + std::to_string(group) + "\n";
+    }
+    const int listed = f < 1500 ? vertices / 2 : vertices;
+    const int corners = form(rng) == 0 ? 4 : 3;
+    std::vector<int32_t> corner;
+    for (int k = 0; k < corners; ++k) corner.push_back(vertex(rng) % (form(rng) == 0 ? vertices : listed));
+    const int how = form(rng);
+    text += how == 1 ? "f\t" : "f ";
+    for (int k = 0; k < corners; ++k) {
+      const int32_t c = corner[k];
+      std::string index = std::to_string(c + 1);
+      if (how == 2 && c < listed) index = std::to_string(c - listed);  // relative
+      if (how == 3) index = "00" + index;
+      if (how == 4) index += "/" + std::to_string(c + 1) + "/7";
+      if (how == 5) index += "//3";
+      text += (k > 0 ? (how == 6 ? "   " : " ") : "") + index;
+    }
+    text += how == 7 ? "  # a comment\n" : how == 8 ? "\r\n" : how == 9 ? " \n" : "\n";
+    for (int k = 1; k + 1 < corners; ++k) {
+      expected.push_back({corner[0], corner[k], corner[k + 1]});
+      polygons.push_back(polygon);
+      groups.push_back(group);
+    }
+    ++polygon;
+  }
+  const mesh::Mesh m = read_obj(text, "mixed.obj");
+  EXPECT_EQ(tris(m), expected);
+  EXPECT_EQ(m.source_polygon, polygons);
+  EXPECT_EQ(m.triangle_group, groups);
+  EXPECT_EQ(m.polygon_count, polygon);
+  EXPECT_EQ(static_cast<int32_t>(m.group_names.size()), group + 1);
 }
 
 TEST(ObjReader, NegativeIndicesAreRelativeToVerticesListedSoFar) {
