@@ -113,7 +113,8 @@ TEST(ObjReader, FacesWrittenEveryWayGiveTheTrianglesWritten) {
     const int listed = f < 1500 ? vertices / 2 : vertices;
     const int corners = form(rng) == 0 ? 4 : 3;
     std::vector<int32_t> corner;
-    for (int k = 0; k < corners; ++k) corner.push_back(vertex(rng) % (form(rng) == 0 ? vertices : listed));
+    for (int k = 0; k < corners; ++k)
+      corner.push_back(vertex(rng) % (form(rng) == 0 ? vertices : listed));
     const int how = form(rng);
     text += how == 1 ? "f\t" : "f ";
     for (int k = 0; k < corners; ++k) {

@@ -30,7 +30,8 @@ void expect_as_fast_float(const std::string& text) {
   ASSERT_EQ(std::bit_cast<uint64_t>(ours), std::bit_cast<uint64_t>(theirs)) << "'" << text << "'";
   // glibc's strtod rounds correctly; the token is what fast_float consumed.
   const std::string token(first, b.ptr);
-  ASSERT_EQ(std::bit_cast<uint64_t>(ours), std::bit_cast<uint64_t>(std::strtod(token.c_str(), nullptr)))
+  ASSERT_EQ(std::bit_cast<uint64_t>(ours),
+            std::bit_cast<uint64_t>(std::strtod(token.c_str(), nullptr)))
       << "'" << token << "'";
 }
 
@@ -57,9 +58,31 @@ TEST(TextScan, CoordinatesParseAsFastFloatAndStrtodWhateverTheirDigits) {
 
 TEST(TextScan, TokensThatAreNotPlainDecimalsGoToFastFloat) {
   for (const char* token :
-       {"-", ".", "-.", ".5", "-.5", "1.", "-0.000000", "0.000000", "1.5x", "1.2.3", "1e5", "-2.5E-3",
-        "0x10", "nan", "-inf", "infinity", "+1", "--1", "123456789012345", "1234567890123456",
-        "0.123456789012345", "0.1234567890123456", "000000000000000001.5", "1,5", "9007199254740993",
+       {"-",
+        ".",
+        "-.",
+        ".5",
+        "-.5",
+        "1.",
+        "-0.000000",
+        "0.000000",
+        "1.5x",
+        "1.2.3",
+        "1e5",
+        "-2.5E-3",
+        "0x10",
+        "nan",
+        "-inf",
+        "infinity",
+        "+1",
+        "--1",
+        "123456789012345",
+        "1234567890123456",
+        "0.123456789012345",
+        "0.1234567890123456",
+        "000000000000000001.5",
+        "1,5",
+        "9007199254740993",
         "179769313486231570000000000000000000000000000000000000000000000000000000000000000000000"
         "00000000000000000000000000000000000000000000000000000000000000000000000000000000000000"
         "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000"
