@@ -172,11 +172,10 @@ class ObjParser {
     for (int k = 0; k < 3; ++k) {
       if (q == end_ || *q != ' ') return false;
       while (q < end_ && *q == ' ') ++q;
-      const char* digits = q;
       int64_t index = 0;
-      while (q < end_ && q - digits < 10 && static_cast<unsigned char>(*q - '0') < 10)
-        index = index * 10 + (*q++ - '0');
-      if (q == digits || index == 0 || index > listed) return false;
+      const auto [after, ec] = detail::parse_integer(q, end_, index);
+      if (ec != std::errc() || after == q || index <= 0 || index > listed) return false;
+      q = after;
       corner[k] = static_cast<int32_t>(index - 1);
     }
     if (q < end_ && *q != '\n') return false;
