@@ -137,9 +137,9 @@ __global__ void leaf_positions_kernel(const int32_t* triangle_at, int32_t n,
   if (p < n) position_of_triangle[triangle_at[p]] = p;
 }
 
-/// later[base + p], per leaf position p: bit d set when the leaf at p + 1 + d holds a triangle of the
-/// fan of one of p's triangle's corners (its neighbours through a vertex with a fan, within
-/// the 64 positions after p).
+/// later[base + p], per leaf position p: bit d set when the leaf at p + 1 + d holds a triangle of
+/// the fan of one of p's triangle's corners (its neighbours through a vertex with a fan, within the
+/// 64 positions after p).
 __global__ void later_neighbors_kernel(const int32_t* triangle_at, int32_t n, int32_t base,
                                        const geom::Tri* triangles, detect::FanView fans,
                                        const int32_t* position_of_triangle, uint64_t* later) {
@@ -208,6 +208,21 @@ class KeyLister {
   int count_ = 0;
 };
 
+/// In a walk kernel whose first blocks hold `walkers` threads and whose blocks past them compute
+/// the part's fans (FanJob), one vertex per thread: whether this block is one of the latter,
+/// its fans then computed. The walks, a few warps per scheduler, leave the SMs room for them.
+__device__ __forceinline__ bool fans_past_walks(const FanJob& fans, int32_t walkers) {
+  const auto walk_blocks = static_cast<int32_t>((walkers + blockDim.x - 1) / blockDim.x);
+  if (static_cast<int32_t>(blockIdx.x) < walk_blocks) return false;
+  const int32_t v =
+      (static_cast<int32_t>(blockIdx.x) - walk_blocks) * static_cast<int32_t>(blockDim.x) +
+      static_cast<int32_t>(threadIdx.x);
+  if (v < fans.count)
+    fans.fan_clear[fans.first + v] =
+        detect::fan_is_clear(fans.positions, fans.planes, fans.fans, fans.first + v);
+  return true;
+}
+
 /// A part's walks above the split level: the leaf at `position` (so that a warp's triangles
 /// are neighbours and follow nearly the same path) against the later leaves, handing over
 /// (position, node) for every overlapping node at `first_unopened` or after (the split level
@@ -220,17 +235,7 @@ __global__ void __launch_bounds__(kNarrowBlock)
                      const uint8_t* degenerate, FanJob fans, SubwalkList subwalks,
                      FrameCounters* counters) {
   wait_for_previous_kernel();
-  const auto walk_blocks =
-      static_cast<int32_t>((tree.shape.leaf_count + blockDim.x - 1) / blockDim.x);
-  if (static_cast<int32_t>(blockIdx.x) >= walk_blocks) {
-    const int32_t v =
-        (static_cast<int32_t>(blockIdx.x) - walk_blocks) * static_cast<int32_t>(blockDim.x) +
-        static_cast<int32_t>(threadIdx.x);
-    if (v < fans.count)
-      fans.fan_clear[fans.first + v] =
-          detect::fan_is_clear(fans.positions, fans.planes, fans.fans, fans.first + v);
-    return;
-  }
+  if (fans_past_walks(fans, tree.shape.leaf_count)) return;
   const int32_t position = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (position >= tree.shape.leaf_count) return;
   const int32_t t = base + tree.triangle_at[position];
@@ -239,6 +244,124 @@ __global__ void __launch_bounds__(kNarrowBlock)
   bvh::for_each_later_overlapping_leaf(
       tree, position, [&](int32_t node) { lister.add(pack(position, node)); }, first_unopened);
   lister.finish();
+}
+
+/// A warp's listing: keys offered by its lanes together are staged in shared memory (kStage
+/// per warp) and appended a batch at a time, one atomic per batch. Every call is made by the
+/// whole warp at once.
+class WarpLister {
+ public:
+  static constexpr unsigned kStage = 128;
+
+  __device__ WarpLister(uint64_t* stage, uint64_t* keys, unsigned long long capacity,
+                        unsigned long long* counter)
+      : stage_(stage), keys_(keys), capacity_(capacity), counter_(counter) {}
+
+  /// Each lane with `has` adds `key`.
+  __device__ __forceinline__ void offer(bool has, uint64_t key) {
+    const unsigned offering = __ballot_sync(0xffffffffu, has);
+    if (!offering) return;
+    if (count_ + 32 > kStage) flush();
+    if (has) stage_[count_ + __popc(offering & ((1u << (threadIdx.x & 31)) - 1u))] = key;
+    count_ += static_cast<unsigned>(__popc(offering));
+  }
+
+  /// Appends what is staged (and must be called once more after the last offer).
+  __device__ void flush() {
+    __syncwarp();
+    if (count_ == 0) return;
+    const unsigned lane = threadIdx.x & 31;
+    unsigned long long base = 0;
+    if (lane == 0) base = atomicAdd(counter_, static_cast<unsigned long long>(count_));
+    base = __shfl_sync(0xffffffffu, base, 0);
+    for (unsigned i = lane; i < count_; i += 32)
+      if (base + i < capacity_) keys_[base + i] = stage_[i];
+    __syncwarp();
+    count_ = 0;
+  }
+
+ private:
+  uint64_t* stage_;
+  uint64_t* keys_;
+  unsigned long long capacity_;
+  unsigned long long* counter_;
+  unsigned count_ = 0;  // the same in every lane
+};
+
+/// Up to this many nodes at the split level (trees of up to ~130K leaves), a self check's walks
+/// above that level run a warp per node (self_split_walk_kernel); above it, a thread per leaf
+/// (self_walk_kernel), whose chains are then spread over enough threads.
+inline constexpr int32_t kSplitWarpNodes = 2048;
+
+/// The later nodes of the split level a warp collects before testing its leaves against them.
+inline constexpr int kLaterChunk = 128;
+
+/// A part's walks above the split level as self_walk_kernel hands them over, a warp per node a
+/// of that level (in leaf order) instead of a thread per leaf: lane l holds the leaves l and
+/// l + 32 under a (at most 64), and hands over for each (bvh::for_each_later_overlap_under_split)
+/// the right siblings of its climb up to a; then the warp tests every later node of the level
+/// against a's box, 32 at a time, and each lane its leaves against those that overlap. Every
+/// step is a few independent loads: the walks of one leaf each were chains of dependent ones
+/// (57 box tests at most at 36K). The same (position, node) pairs, in another order; degenerate
+/// leaves hand over nothing. The blocks past the walks' compute the part's fans (FanJob).
+__global__ void __launch_bounds__(kNarrowBlock)
+    self_split_walk_kernel(bvh::TreeView tree, int32_t base, const uint8_t* degenerate, FanJob fans,
+                           SubwalkList subwalks, FrameCounters* counters) {
+  wait_for_previous_kernel();
+  const bvh::LevelNodes split = bvh::level_nodes(bvh::split_walk_level(tree.shape));
+  if (fans_past_walks(fans, split.count * 32)) return;
+  __shared__ uint64_t stage[kNarrowBlock / 32][WarpLister::kStage];
+  __shared__ int32_t later[kNarrowBlock / 32][kLaterChunk];
+  const int warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
+  const int32_t end = split.first + split.count;
+  const int32_t a =
+      split.first + static_cast<int32_t>((blockIdx.x * blockDim.x + threadIdx.x) / 32);
+  if (a >= end) return;  // a whole warp: blocks hold whole warps
+  WarpLister lister(stage[warp], subwalks.walks, subwalks.capacity, &counters->subwalks);
+  int32_t begin, past;
+  tree.shape.positions_under(a, begin, past);
+  int32_t position[2];
+  bool walks[2];
+  geom::Box3f box[2];
+  for (int k = 0; k < 2; ++k) {
+    position[k] = begin + lane + 32 * k;
+    walks[k] = position[k] < past && !degenerate[base + tree.triangle_at[position[k]]];
+    if (walks[k]) box[k] = tree.boxes[tree.shape.leaf_at(position[k])];
+  }
+  // The climb under the split level: at most 6 levels (D - split level).
+  const int32_t below = 2 * split.first + 1;
+  for (int k = 0; k < 2; ++k) {
+    int32_t node = walks[k] ? tree.shape.leaf_at(position[k]) : 0;
+    for (int step = 0; step < 6; ++step) {
+      const bool climbing = node >= below;
+      const bool hand = climbing && (node & 1) && geom::overlap(box[k], tree.boxes[node + 1]);
+      lister.offer(hand, pack(position[k], node + 1));
+      if (climbing) node = (node - 1) >> 1;
+    }
+  }
+  // The later nodes of the split level that overlap a, then the leaves against them, a chunk
+  // at a time.
+  const geom::Box3f a_box = tree.boxes[a];
+  int count = 0;
+  for (int32_t first = a + 1; first < end; first += 32) {
+    const int32_t b = first + lane;
+    const bool overlapping = b < end && geom::overlap(a_box, tree.boxes[b]);
+    const unsigned found = __ballot_sync(0xffffffffu, overlapping);
+    if (overlapping) later[warp][count + __popc(found & ((1u << lane) - 1u))] = b;
+    count += __popc(found);
+    if (count > kLaterChunk - 32 || first + 32 >= end) {
+      __syncwarp();
+      for (int i = 0; i < count; ++i) {
+        const int32_t node = later[warp][i];
+        const geom::Box3f node_box = tree.boxes[node];
+        for (int k = 0; k < 2; ++k)
+          lister.offer(walks[k] && geom::overlap(box[k], node_box), pack(position[k], node));
+      }
+      __syncwarp();
+      count = 0;
+    }
+  }
+  lister.flush();
 }
 
 /// Two parts' walks above the split level of `other`: the leaf at `position` of `tree` (part
@@ -548,8 +671,7 @@ void launch_later_neighbors(const bvh::TreeView& tree, int32_t base, const geom:
                             cudaStream_t stream) {
   const int32_t n = tree.shape.leaf_count;
   if (n <= 0) return;
-  launch_chained_items(leaf_positions_kernel, n, stream, tree.triangle_at, n,
-                       position_of_triangle);
+  launch_chained_items(leaf_positions_kernel, n, stream, tree.triangle_at, n, position_of_triangle);
   launch_chained_items(later_neighbors_kernel, n, stream, tree.triangle_at, n, base, triangles,
                        fans, position_of_triangle, later);
 }
@@ -612,13 +734,21 @@ void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs
                        const CandidateList& listed, const ResultBuffers& results,
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
-  // Blocks of kNarrowBlock: 36K leaves are only ~270 walks per SM of an H100, spread evenly.
-  // The fans' blocks follow the walks' (self_walk_kernel).
-  const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(tree.shape));
-  const unsigned blocks = blocks_for(tree.shape.leaf_count, kNarrowBlock) +
-                          blocks_for(std::max(fans.count, 0), kNarrowBlock);
-  launch_chained(self_walk_kernel, dim3(blocks), dim3(kNarrowBlock), stream, tree, base,
-                 first_unopened, inputs.degenerate, fans, subwalks, results.counters);
+  // The walks' blocks, then the fans' (FanJob). Blocks of kNarrowBlock: 36K leaves are only
+  // ~270 walks per SM of an H100, spread evenly; a warp per node of the split level, two.
+  const bvh::LevelNodes split = bvh::level_nodes(bvh::split_walk_level(tree.shape));
+  const unsigned fan_blocks = blocks_for(std::max(fans.count, 0), kNarrowBlock);
+  if (split.count <= kSplitWarpNodes) {
+    launch_chained(self_split_walk_kernel,
+                   dim3(blocks_for(split.count * 32, kNarrowBlock) + fan_blocks),
+                   dim3(kNarrowBlock), stream, tree, base, inputs.degenerate, fans, subwalks,
+                   results.counters);
+  } else {
+    launch_chained(self_walk_kernel,
+                   dim3(blocks_for(tree.shape.leaf_count, kNarrowBlock) + fan_blocks),
+                   dim3(kNarrowBlock), stream, tree, base, split.first, inputs.degenerate, fans,
+                   subwalks, results.counters);
+  }
   launch_subwalks(tree, base, tree, drop, subwalks, listed, results, stream);
   launch_pair_tests(inputs, tree, base, listed, results, use, max_blocks, stream);
 }
@@ -630,8 +760,8 @@ void launch_cross_check(const bvh::TreeView& tree, int32_t base_a, const bvh::Tr
   if (tree.shape.leaf_count <= 0 || other.shape.leaf_count <= 0) return;
   const int32_t first_unopened = bvh::CompleteTree::level_begin(bvh::split_walk_level(other.shape));
   launch_chained(cross_walk_kernel, dim3(blocks_for(tree.shape.leaf_count, kNarrowBlock)),
-                 dim3(kNarrowBlock), stream, tree, base_a, other, first_unopened,
-                 inputs.degenerate, subwalks, results.counters);
+                 dim3(kNarrowBlock), stream, tree, base_a, other, first_unopened, inputs.degenerate,
+                 subwalks, results.counters);
   launch_subwalks(tree, base_a, other, NeighborDrop{}, subwalks, listed, results, stream);
   launch_pair_tests(inputs, other, base_b, listed, results, use, max_blocks, stream);
 }

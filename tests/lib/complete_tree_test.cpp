@@ -60,6 +60,22 @@ mesh::MeshView soup_view(const Soup& soup) {
   return mesh::view_of(soup.positions, soup.triangles);
 }
 
+/// A random soup and its tree (built on two threads): a traversal test's case.
+struct SoupTree {
+  Soup soup;
+  Tree tree;
+};
+SoupTree soup_tree(int32_t n, uint32_t seed, double size) {
+  SoupTree built{random_soup(n, seed, size), Tree{}};
+  built.tree.build(soup_view(built.soup), 2);
+  return built;
+}
+/// What a failure in such a case says of it.
+std::string soup_case(int32_t n, double size, uint32_t seed) {
+  return "n=" + std::to_string(n) + " size=" + std::to_string(size) +
+         " seed=" + std::to_string(seed);
+}
+
 void expect_boxes_nest(const Tree& tree, const Soup& soup) {
   const auto& boxes = tree.boxes();
   const CompleteTree& shape = tree.shape();
@@ -181,12 +197,10 @@ TEST(Traversal, VisitsEachOverlappingPairOnceFromTheEarlierLeaf) {
   for (int32_t n : {1, 2, 3, 9, 50, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {
       const uint32_t seed = static_cast<uint32_t>(n * 31 + size * 7);
-      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
-                   " seed=" + std::to_string(seed));
-      Soup soup = random_soup(n, seed, size);
-      Tree tree;
-      tree.build(soup_view(soup), 2);
-      const TreeView view = tree.view();
+      SCOPED_TRACE(soup_case(n, size, seed));
+      SoupTree built = soup_tree(n, seed, size);
+      const Soup& soup = built.soup;
+      const TreeView view = built.tree.view();
       const PairMultiset visited = per_leaf_pairs(view);
       PairMultiset expected;
       for (int32_t a = 0; a < n; ++a)
@@ -267,6 +281,51 @@ TEST(Traversal, WalksSplitAtAnyLevelVisitTheSamePairsOnce) {
           ASSERT_EQ(leaves, expected_leaves) << "n=" << n << " query=" << query << " cut=" << cut;
         }
       }
+    }
+  }
+}
+
+TEST(Traversal, WalksAboveTheSplitHandOverWhatTheClimbAndTheSplitLevelsNodesGive) {
+  // The GPU's warp per node of the split level (up to 2,048 of them): each leaf's handovers are
+  // those of its climb under the split level and every later node of that level that overlaps
+  // both the leaf's own node and the leaf. The same multiset as the per-leaf walk's, for every
+  // tree shape up to 300 leaves and larger ones, small and large triangles.
+  std::vector<int32_t> sizes;
+  for (int32_t n = 1; n <= 300; ++n) sizes.push_back(n);
+  for (int32_t n : {511, 512, 513, 2000, 4097}) sizes.push_back(n);
+  for (int32_t n : sizes) {
+    for (double size : {0.2, 1.0, 4.0}) {
+      if (n <= 300 && size != 1.0 && n % 7 != 0) continue;
+      const uint32_t seed = static_cast<uint32_t>(n * 29 + size * 11);
+      SCOPED_TRACE(soup_case(n, size, seed));
+      SoupTree built = soup_tree(n, seed, size);
+      const TreeView view = built.tree.view();
+      const LevelNodes split = level_nodes(split_walk_level(view.shape));
+      std::multiset<std::pair<int32_t, int32_t>> expected, handed;
+      int64_t later_nodes = 0;
+      for (int32_t p = 0; p < n; ++p) {
+        for_each_later_overlapping_leaf(
+            view, p,
+            [&](int32_t node) {
+              expected.insert({p, node});
+            },
+            split.first);
+        for_each_later_overlap_under_split(view, p, split.first, [&](int32_t node) {
+          handed.insert({p, node});
+        });
+        // The leaf's own node of the split level: its ancestor at that level.
+        int32_t own = view.shape.leaf_at(p);
+        while (own >= 2 * split.first + 1) own = (own - 1) >> 1;
+        ASSERT_TRUE(own >= split.first && own < split.first + split.count);
+        const geom::Box3f box = view.boxes[view.shape.leaf_at(p)];
+        for (int32_t b = own + 1; b < split.first + split.count; ++b)
+          if (geom::overlap(view.boxes[own], view.boxes[b]) && geom::overlap(box, view.boxes[b])) {
+            handed.insert({p, b});
+            ++later_nodes;
+          }
+      }
+      ASSERT_EQ(handed, expected);
+      if (n >= 513 && size >= 1.0) EXPECT_GT(later_nodes, 0);
     }
   }
 }
@@ -378,12 +437,9 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
   for (int32_t n : {1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 100, 513, 2000}) {
     for (double size : {0.2, 1.0, 4.0}) {
       const uint32_t seed = static_cast<uint32_t>(n * 17 + size * 3);
-      SCOPED_TRACE("n=" + std::to_string(n) + " size=" + std::to_string(size) +
-                   " seed=" + std::to_string(seed));
-      Soup soup = random_soup(n, seed, size);
-      Tree tree;
-      tree.build(soup_view(soup), 2);
-      const TreeView view = tree.view();
+      SCOPED_TRACE(soup_case(n, size, seed));
+      SoupTree built = soup_tree(n, seed, size);
+      const TreeView view = built.tree.view();
       const PairMultiset per_leaf = per_leaf_pairs(view);
       ASSERT_EQ(grouped_pairs<4>(view), per_leaf);
       ASSERT_EQ(grouped_pairs<8>(view), per_leaf);

@@ -152,6 +152,35 @@ SNAG_HD_INLINE int32_t split_walk_level(const CompleteTree& shape) {
   return shape.depth > 6 ? shape.depth - 6 : 0;
 }
 
+/// The nodes of level `level`: [first, first + count), 2^level of them (every level above D - 1
+/// is full, the split level among them).
+struct LevelNodes {
+  int32_t first = 0;
+  int32_t count = 0;
+};
+
+SNAG_HD_INLINE LevelNodes level_nodes(int32_t level) {
+  return {CompleteTree::level_begin(level), int32_t{1} << level};
+}
+
+/// The part of for_each_later_overlapping_leaf(tree, position, visit, first_unopened) that lies
+/// under the leaf's own node of the split level, first_unopened being that level's first node
+/// `split_first`: for each ancestor of the leaf under the split level reached from a left child,
+/// the right sibling, handed over whole when its box overlaps the leaf's. The rest of what that
+/// walk hands over is every later node of the split level whose box overlaps the leaf's (each
+/// of them overlaps the leaf's own node of that level, which holds the leaf's box): the GPU
+/// finds those by testing every later node of the level against the leaf's own node, a warp per
+/// node, then against the leaf.
+template <class Visit>
+SNAG_HD_INLINE void for_each_later_overlap_under_split(TreeView tree, int32_t position,
+                                                       int32_t split_first, Visit&& visit) {
+  const int32_t leaf = tree.shape.leaf_at(position);
+  const geom::Box3f box = tree.boxes[leaf];
+  const int32_t below = 2 * split_first + 1;  // the first node of the level under it
+  for (int32_t node = leaf; node >= below; node = (node - 1) >> 1)
+    if ((node & 1) && geom::overlap(box, tree.boxes[node + 1])) visit(node + 1);
+}
+
 /// for_each_later_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlap(TreeView tree, int32_t position, Visit&& visit) {
