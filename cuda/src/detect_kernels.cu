@@ -288,7 +288,7 @@ class WarpLister {
   unsigned count_ = 0;  // the same in every lane
 };
 
-/// Up to this many nodes at the split level (trees of up to ~130K leaves), a self check's walks
+/// Up to this many nodes at the split level (trees of up to 131,072 leaves), a self check's walks
 /// above that level run a warp per node (self_split_walk_kernel); above it, a thread per leaf
 /// (self_walk_kernel), whose chains are then spread over enough threads.
 inline constexpr int32_t kSplitWarpNodes = 2048;
