@@ -735,7 +735,8 @@ void launch_self_check(const bvh::TreeView& tree, int32_t base, const PairInputs
                        detect::FilterUse use, unsigned max_blocks, cudaStream_t stream) {
   if (tree.shape.leaf_count <= 0) return;
   // The walks' blocks, then the fans' (FanJob). Blocks of kNarrowBlock: 36K leaves are only
-  // ~270 walks per SM of an H100, spread evenly; a warp per node of the split level, two.
+  // ~270 walks per SM of an H100, spread evenly; with a warp per node of the split level, two
+  // nodes a block.
   const bvh::LevelNodes split = bvh::level_nodes(bvh::split_walk_level(tree.shape));
   const unsigned fan_blocks = blocks_for(std::max(fans.count, 0), kNarrowBlock);
   if (split.count <= kSplitWarpNodes) {

@@ -212,8 +212,7 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// overlapping node there to `subwalks` (for trees of up to 2,048 nodes at that level, a warp
 /// per node of the level hands over the same, its leaves' climbs and the later nodes of the
 /// level that overlap them: bvh::for_each_later_overlap_under_split); then one thread per
-/// subwalk walks that node's
-/// subtree, listing every overlapping leaf into `listed`, counted in
+/// subwalk walks that node's subtree, listing every overlapping leaf into `listed`, counted in
 /// results.counters->listed (which the caller zeroes first, with ->subwalks and ->screened).
 /// The longest walk of a folded region's leaf (267 box tests at 36K) was the walk kernel's
 /// time, at two warps per scheduler: split, it is two chains of at most ~60, the second over

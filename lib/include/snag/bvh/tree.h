@@ -152,8 +152,8 @@ SNAG_HD_INLINE int32_t split_walk_level(const CompleteTree& shape) {
   return shape.depth > 6 ? shape.depth - 6 : 0;
 }
 
-/// The nodes of level `level`: [first, first + count), 2^level of them (every level above D - 1
-/// is full, the split level among them).
+/// The nodes of level `level`: [first, first + count), 2^level of them (levels 0 to D - 1 are
+/// full, the split level among them).
 struct LevelNodes {
   int32_t first = 0;
   int32_t count = 0;
@@ -165,12 +165,14 @@ SNAG_HD_INLINE LevelNodes level_nodes(int32_t level) {
 
 /// The part of for_each_later_overlapping_leaf(tree, position, visit, first_unopened) that lies
 /// under the leaf's own node of the split level, first_unopened being that level's first node
-/// `split_first`: for each ancestor of the leaf under the split level reached from a left child,
-/// the right sibling, handed over whole when its box overlaps the leaf's. The rest of what that
-/// walk hands over is every later node of the split level whose box overlaps the leaf's (each
-/// of them overlaps the leaf's own node of that level, which holds the leaf's box): the GPU
-/// finds those by testing every later node of the level against the leaf's own node, a warp per
-/// node, then against the leaf.
+/// `split_first`: for each node on the path from the leaf up to (not including) that level
+/// that is a left child, its right sibling, handed over whole when its box overlaps the leaf's
+/// (at most 6 of them: the split level is 6 above the deepest). The rest of what that walk
+/// hands over is every later node of the split level whose box overlaps the leaf's: the GPU
+/// finds those by testing every later node of the level against the leaf's own node of that
+/// level, a warp per node, then against the leaf. That node's box holds the leaf's (every box
+/// is its children's merged exactly), so a node that misses it misses the leaf, as the walk's
+/// own pruning assumes.
 template <class Visit>
 SNAG_HD_INLINE void for_each_later_overlap_under_split(TreeView tree, int32_t position,
                                                        int32_t split_first, Visit&& visit) {
