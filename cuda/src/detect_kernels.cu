@@ -298,8 +298,8 @@ inline constexpr int kLaterChunk = 128;
 
 /// A part's walks above the split level as self_walk_kernel hands them over, a warp per node a
 /// of that level (in leaf order) instead of a thread per leaf: lane l holds the leaves l and
-/// l + 32 under a (at most 64), and hands over for each (bvh::for_each_later_overlap_under_split)
-/// the right siblings of its climb up to a; then the warp tests every later node of the level
+/// l + 32 under a (at most 64), and hands over for each (bvh::climb_under_split) the right
+/// siblings of its climb up to a; then the warp tests every later node of the level
 /// against a's box, 32 at a time, and each lane its leaves against those that overlap. Every
 /// step is a few independent loads: the walks of one leaf each were chains of dependent ones
 /// (57 box tests at most at 36K). The same (position, node) pairs, in another order; degenerate
@@ -328,17 +328,11 @@ __global__ void __launch_bounds__(kNarrowBlock)
     walks[k] = position[k] < past && !degenerate[base + tree.triangle_at[position[k]]];
     if (walks[k]) box[k] = tree.boxes[tree.shape.leaf_at(position[k])];
   }
-  // The climb under the split level: at most 6 levels (D - split level).
-  const int32_t below = 2 * split.first + 1;
-  for (int k = 0; k < 2; ++k) {
-    int32_t node = walks[k] ? tree.shape.leaf_at(position[k]) : 0;
-    for (int step = 0; step < 6; ++step) {
-      const bool climbing = node >= below;
-      const bool hand = climbing && (node & 1) && geom::overlap(box[k], tree.boxes[node + 1]);
-      lister.offer(hand, pack(position[k], node + 1));
-      if (climbing) node = (node - 1) >> 1;
-    }
-  }
+  // The climb under the split level, each step a warp-wide offer.
+  for (int k = 0; k < 2; ++k)
+    bvh::climb_under_split(
+        tree, walks[k] ? tree.shape.leaf_at(position[k]) : 0, box[k], split.first,
+        [&](bool hand, int32_t sibling) { lister.offer(hand, pack(position[k], sibling)); });
   // The later nodes of the split level that overlap a, then the leaves against them, a chunk
   // at a time.
   const geom::Box3f a_box = tree.boxes[a];

@@ -211,7 +211,7 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// are the topology's) walks the later leaves' subtrees down to that level, handing every
 /// overlapping node there to `subwalks` (for trees of up to 2,048 nodes at that level, a warp
 /// per node of the level hands over the same, its leaves' climbs and the later nodes of the
-/// level that overlap them: bvh::for_each_later_overlap_under_split); then one thread per
+/// level that overlap them: bvh::climb_under_split); then one thread per
 /// subwalk walks that node's subtree, listing every overlapping leaf into `listed`, counted in
 /// results.counters->listed (which the caller zeroes first, with ->subwalks and ->screened).
 /// The longest walk of a folded region's leaf (267 box tests at 36K) was the walk kernel's

@@ -310,9 +310,11 @@ TEST(Traversal, WalksAboveTheSplitHandOverWhatTheClimbAndTheSplitLevelsNodesGive
               expected.insert({p, node});
             },
             split.first);
-        for_each_later_overlap_under_split(view, p, split.first, [&](int32_t node) {
-          handed.insert({p, node});
-        });
+        const int32_t leaf = view.shape.leaf_at(p);
+        climb_under_split(view, leaf, view.boxes[leaf], split.first,
+                          [&](bool hand, int32_t sibling) {
+                            if (hand) handed.insert({p, sibling});
+                          });
         // The leaf's own node of the split level: its ancestor at that level.
         int32_t own = view.shape.leaf_at(p);
         while (own >= 2 * split.first + 1) own = (own - 1) >> 1;

@@ -163,24 +163,32 @@ SNAG_HD_INLINE LevelNodes level_nodes(int32_t level) {
   return {CompleteTree::level_begin(level), int32_t{1} << level};
 }
 
+/// At most this many levels lie between a leaf and its ancestor on the split level.
+inline constexpr int kLevelsUnderSplit = 6;
+
 /// The part of for_each_later_overlapping_leaf(tree, position, visit, first_unopened) that lies
 /// under the leaf's own node of the split level, first_unopened being that level's first node
-/// `split_first`: for each node on the path from the leaf up to (not including) that level
-/// that is a left child, its right sibling, handed over whole when its box overlaps the leaf's
-/// (at most 6 of them: the split level is 6 above the deepest). The rest of what that walk
-/// hands over is every later node of the split level whose box overlaps the leaf's: the GPU
-/// finds those by testing every later node of the level against the leaf's own node of that
-/// level, a warp per node, then against the leaf. That node's box holds the leaf's (every box
-/// is its children's merged exactly), so a node that misses it misses the leaf, as the walk's
-/// own pruning assumes.
-template <class Visit>
-SNAG_HD_INLINE void for_each_later_overlap_under_split(TreeView tree, int32_t position,
-                                                       int32_t split_first, Visit&& visit) {
-  const int32_t leaf = tree.shape.leaf_at(position);
-  const geom::Box3f box = tree.boxes[leaf];
+/// `split_first`: for each node on the path from `leaf` (the leaf's node index, `box` its box)
+/// up to (not including) that level that is a left child, its right sibling, handed over whole
+/// when its box overlaps the leaf's. Calls step(hand, sibling) exactly kLevelsUnderSplit times,
+/// `hand` false for a step that hands nothing over (a right child, a sibling that misses, or a
+/// step past the climb's end), so that the lanes of a warp can take the steps side by side,
+/// each a warp-wide call; a `leaf` of 0 (the root) hands nothing over. The rest of what that
+/// walk hands over is every later node of the split level whose box overlaps the leaf's: the
+/// GPU finds those by testing every later node of the level against the leaf's own node of
+/// that level, a warp per node, then against the leaf. That node's box holds the leaf's (every
+/// box is its children's merged exactly), so a node that misses it misses the leaf, as the
+/// walk's own pruning assumes.
+template <class Step>
+SNAG_HD_INLINE void climb_under_split(TreeView tree, int32_t leaf, const geom::Box3f& box,
+                                      int32_t split_first, Step&& step) {
   const int32_t below = 2 * split_first + 1;  // the first node of the level under it
-  for (int32_t node = leaf; node >= below; node = (node - 1) >> 1)
-    if ((node & 1) && geom::overlap(box, tree.boxes[node + 1])) visit(node + 1);
+  int32_t node = leaf;
+  for (int level = 0; level < kLevelsUnderSplit; ++level) {
+    const bool climbing = node >= below;
+    step(climbing && (node & 1) && geom::overlap(box, tree.boxes[node + 1]), node + 1);
+    if (climbing) node = (node - 1) >> 1;
+  }
 }
 
 /// for_each_later_overlapping_leaf, calling visit(triangle) with the leaf's triangle.
