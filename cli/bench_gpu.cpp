@@ -8,8 +8,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <span>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "backend_factory.h"
@@ -85,7 +88,39 @@ struct Row {
   int64_t pairs = 0, candidates = 0;
   bool same = true;
   std::string note;
+  /// A SNAG_CUDA_TRACE build's timeline of a device-resident frame: per launch, medians over
+  /// the timed frames that made the most common number of launches.
+  std::vector<cuda::CudaBackend::TracedLaunch> trace;
+  int traced_frames = 0;
 };
+
+/// Per launch, the medians of `frames` (each a frame's launches in start order) over those
+/// frames that made the most common number of launches; how many those were.
+std::pair<std::vector<cuda::CudaBackend::TracedLaunch>, int> median_trace(
+    const std::vector<std::vector<cuda::CudaBackend::TracedLaunch> >& frames) {
+  std::map<size_t, int> lengths;
+  for (const auto& f : frames) ++lengths[f.size()];
+  if (lengths.empty()) return {{}, 0};
+  const size_t length =
+      std::ranges::max_element(lengths, {}, [](const auto& l) { return l.second; })->first;
+  std::vector<cuda::CudaBackend::TracedLaunch> medians(length);
+  int used = 0;
+  for (size_t k = 0; k < length; ++k) {
+    std::vector<double> began, first, last;
+    for (const auto& f : frames) {
+      if (f.size() != length) continue;
+      began.push_back(f[k].began);
+      first.push_back(f[k].passed_first);
+      last.push_back(f[k].passed_last);
+      medians[k].threads = f[k].threads;
+    }
+    used = static_cast<int>(began.size());
+    medians[k].began = median(began);
+    medians[k].passed_first = median(first);
+    medians[k].passed_last = median(last);
+  }
+  return {medians, used};
+}
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -182,10 +217,13 @@ Row run_case(const BenchCase& c, const BenchGpuOptions& o) {
   // Whole frames as the checker runs them: scan (with the refit and the quality queued ahead),
   // refit, quality, traversal with the narrow phase, pairs back on the host; positions already
   // on the device, then from host memory.
+  // In a SNAG_CUDA_TRACE build, each device-resident frame's launches (taken after its time).
+  std::vector<std::vector<cuda::CudaBackend::TracedLaunch> > traces;
   for (int from_host = 0; from_host < 2; ++from_host) {
     for (int it = 0; it < iterations; ++it) {
       const int f = it % file_count;
       if (!from_host) gpu->select_resident_frame(f);
+      if (!from_host) gpu->take_stream_trace();  // what came before is not this frame's
       gpu->start_timer();
       if (from_host) gpu->set_positions(meshes[f].positions);
       const std::vector<int32_t> degenerate = degenerate_of(*gpu);
@@ -193,6 +231,7 @@ Row run_case(const BenchCase& c, const BenchGpuOptions& o) {
       gpu->tree_quality();
       gpu->detect(degenerate);
       const double ms = gpu->stop_timer();
+      if (!from_host && it >= o.warmup) traces.push_back(gpu->take_stream_trace());
       if (it < o.warmup) continue;
       const cuda::StageTimes t = gpu->last_times();
       if (from_host) {
@@ -234,6 +273,7 @@ Row run_case(const BenchCase& c, const BenchGpuOptions& o) {
   row.upload = median(upload);
   row.cpu_build = median(cpu_build);
   row.cpu_frame = median(cpu_frame);
+  std::tie(row.trace, row.traced_frames) = median_trace(traces);
   return row;
 }
 
@@ -262,6 +302,24 @@ void print_tables(const std::vector<Row>& rows, const std::string& device, int t
         r.frame > 0 ? r.cpu_frame / r.frame : 0.0, static_cast<long long>(r.pairs),
         r.same ? "yes" : "NO");
     if (!r.note.empty()) std::printf("  %s\n", r.note.c_str());
+  }
+  if (std::ranges::any_of(rows, [](const Row& r) { return !r.trace.empty(); })) {
+    std::printf(
+        "\nStream trace (a SNAG_CUDA_TRACE build): each device-resident frame's kernel launches in "
+        "start order, microseconds on the device's clock from the first one's start, medians over "
+        "the timed frames with the usual number of launches; began = its first block's start, "
+        "passed = its first and last blocks past the wait for the kernel ahead (the first pass is "
+        "about where that kernel ended); threads tell the kernels apart (cuda/NOTES.md)\n");
+    for (const Row& r : rows) {
+      if (r.trace.empty()) continue;
+      std::printf("%s (%d frames):\n", r.name.c_str(), r.traced_frames);
+      std::printf("  %6s %10s %10s %12s %11s\n", "launch", "threads", "began", "passed first",
+                  "passed last");
+      for (size_t k = 0; k < r.trace.size(); ++k)
+        std::printf("  %6zu %10lld %10.2f %12.2f %11.2f\n", k,
+                    static_cast<long long>(r.trace[k].threads), r.trace[k].began,
+                    r.trace[k].passed_first, r.trace[k].passed_last);
+    }
   }
   std::printf("\nThe seed paper's table (GPU / CPU), for the same sizes:\n");
   std::printf("%9s %24s %22s %22s\n", "triangles", "build", "refit", "traverse");

@@ -783,3 +783,5 @@ void launch_finish(const FrameCounters* counters, const PairSet& set, const uint
 }
 
 }  // namespace snag::cuda
+
+SNAG_CUDA_TRACE_UNIT(detect_kernels)

@@ -507,3 +507,5 @@ double DeviceTree::quality(cudaStream_t stream) {
 }
 
 }  // namespace snag::cuda
+
+SNAG_CUDA_TRACE_UNIT(device_tree)

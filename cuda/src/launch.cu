@@ -6,6 +6,8 @@
 #include <tuple>
 #include <vector>
 
+#include "snag/cuda/cuda_backend.h"
+
 namespace snag::cuda {
 
 namespace {
@@ -31,6 +33,26 @@ bool chained_launches_supported() {
   const bool yes = major >= 9 && probe.ptxVersion >= 90 && probe.binaryVersion >= 90;
   answers[device].store(yes ? 2 : 1, std::memory_order_relaxed);
   return yes;
+}
+
+#if defined(SNAG_CUDA_TRACE)
+void point_stream_trace_detect_kernels(TraceRecord* records);
+void point_stream_trace_device_tree(TraceRecord* records);
+#endif
+
+bool stream_trace_compiled() {
+#if defined(SNAG_CUDA_TRACE)
+  return true;
+#else
+  return false;
+#endif
+}
+
+void point_stream_trace([[maybe_unused]] TraceRecord* records) {
+#if defined(SNAG_CUDA_TRACE)
+  point_stream_trace_detect_kernels(records);
+  point_stream_trace_device_tree(records);
+#endif
 }
 
 unsigned resident_blocks(const void* kernel, int block_threads) {

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "cuda_check.cuh"
+#include "trace.cuh"
 
 namespace snag::cuda {
 
@@ -75,11 +76,18 @@ void launch_chained_items(void (*kernel)(Params...), int64_t count, cudaStream_t
 /// The start of every kernel launched by launch_chained: waits until the kernel ahead of it
 /// on the stream has finished and its writes are visible, then lets the kernel after it be
 /// scheduled (its blocks then wait here in turn). A no-op for a kernel launched otherwise,
-/// and on targets before compute capability 9.0.
+/// and on targets before compute capability 9.0. In a SNAG_CUDA_TRACE build, also where the
+/// launch records itself (trace.cuh).
 __device__ __forceinline__ void wait_for_previous_kernel() {
+#if defined(SNAG_CUDA_TRACE)
+  const unsigned long long began = trace_clock();
+#endif
 #if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
   asm volatile("griddepcontrol.wait;" ::: "memory");
   asm volatile("griddepcontrol.launch_dependents;" ::: "memory");
+#endif
+#if defined(SNAG_CUDA_TRACE)
+  trace_launch(began);
 #endif
 }
 

@@ -80,7 +80,23 @@ class CudaBackend : public detect::Backend {
     int64_t detects = 0;
   };
   virtual AheadTaken ahead_taken() const = 0;
+  /// One kernel launch as a stream trace saw it (a build with SNAG_CUDA_TRACE, for profiling;
+  /// cuda/src/trace.cuh): microseconds on the device's clock from the trace's first launch.
+  struct TracedLaunch {
+    int64_t threads = 0;      ///< the grid's threads, which tell the kernels apart
+    double began = 0;         ///< its first block's start (before waiting for the kernel ahead)
+    double passed_first = 0;  ///< its first block past that wait
+    double passed_last = 0;   ///< its last block past it
+  };
+  /// The launches recorded since the last call, in start order (the first call starts the
+  /// recording and returns none); none in a build without SNAG_CUDA_TRACE. Waits for the device.
+  /// One backend of a process is traced at a time (the last one to call this).
+  virtual std::vector<TracedLaunch> take_stream_trace() = 0;
 };
+
+/// Whether this build's kernels record stream traces (the CMake option SNAG_CUDA_TRACE, for
+/// profiling; CudaBackend::take_stream_trace).
+bool stream_trace_compiled();
 
 /// The CUDA backend on device `device` (0-based). Throws snag::UsageError when there is no such
 /// device, snag::InternalError when a CUDA call fails.
