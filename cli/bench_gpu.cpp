@@ -89,37 +89,38 @@ struct Row {
   bool same = true;
   std::string note;
   /// A SNAG_CUDA_TRACE build's timeline of a device-resident frame: per launch, medians over
-  /// the timed frames that made the most common number of launches.
+  /// the timed frames whose launches came in the most common order.
   std::vector<cuda::CudaBackend::TracedLaunch> trace;
   int traced_frames = 0;
 };
 
-/// Per launch, the medians of `frames` (each a frame's launches in start order) over those
-/// frames that made the most common number of launches; how many those were.
+/// Per launch, the medians of `frames` (each a frame's launches in start order) over the
+/// frames whose launches came in the most common order (the side stream's kernels may start
+/// before or after a main-stream one), told by their thread counts; how many those were.
 std::pair<std::vector<cuda::CudaBackend::TracedLaunch>, int> median_trace(
     const std::vector<std::vector<cuda::CudaBackend::TracedLaunch> >& frames) {
-  std::map<size_t, int> lengths;
-  for (const auto& f : frames) ++lengths[f.size()];
-  if (lengths.empty()) return {{}, 0};
-  const size_t length =
-      std::ranges::max_element(lengths, {}, [](const auto& l) { return l.second; })->first;
-  std::vector<cuda::CudaBackend::TracedLaunch> medians(length);
-  int used = 0;
-  for (size_t k = 0; k < length; ++k) {
+  const auto order_of = [](const std::vector<cuda::CudaBackend::TracedLaunch>& frame) {
+    std::vector<int64_t> threads;
+    for (const auto& launch : frame) threads.push_back(launch.threads);
+    return threads;
+  };
+  std::map<std::vector<int64_t>, int> orders;
+  for (const auto& f : frames) ++orders[order_of(f)];
+  if (orders.empty()) return {{}, 0};
+  const auto usual = std::ranges::max_element(orders, {}, [](const auto& o) { return o.second; });
+  const std::vector<int64_t>& order = usual->first;
+  std::vector<cuda::CudaBackend::TracedLaunch> medians(order.size());
+  for (size_t k = 0; k < order.size(); ++k) {
     std::vector<double> began, first, last;
     for (const auto& f : frames) {
-      if (f.size() != length) continue;
+      if (order_of(f) != order) continue;
       began.push_back(f[k].began);
       first.push_back(f[k].passed_first);
       last.push_back(f[k].passed_last);
-      medians[k].threads = f[k].threads;
     }
-    used = static_cast<int>(began.size());
-    medians[k].began = median(began);
-    medians[k].passed_first = median(first);
-    medians[k].passed_last = median(last);
+    medians[k] = {order[k], median(began), median(first), median(last)};
   }
-  return {medians, used};
+  return {medians, usual->second};
 }
 
 double ms_since(Clock::time_point start) {
@@ -307,9 +308,10 @@ void print_tables(const std::vector<Row>& rows, const std::string& device, int t
     std::printf(
         "\nStream trace (a SNAG_CUDA_TRACE build): each device-resident frame's kernel launches in "
         "start order, microseconds on the device's clock from the first one's start, medians over "
-        "the timed frames with the usual number of launches; began = its first block's start, "
-        "passed = its first and last blocks past the wait for the kernel ahead (the first pass is "
-        "about where that kernel ended); threads tell the kernels apart (cuda/NOTES.md)\n");
+        "the timed frames whose launches came in the usual order; began = its first block's "
+        "start, passed = its first and last blocks past the wait for the kernel ahead on its "
+        "stream (the first pass is about where that kernel ended); threads tell the kernels apart "
+        "(cuda/NOTES.md)\n");
     for (const Row& r : rows) {
       if (r.trace.empty()) continue;
       std::printf("%s (%d frames):\n", r.name.c_str(), r.traced_frames);

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cstddef>
 #include <cstring>
-#include <exception>
 #include <cub/device/device_radix_sort.cuh>
 #include <utility>
 
@@ -81,47 +80,28 @@ class CudaBackendImpl final : public CudaBackend {
     // detect queued ahead of it.
     if (side_stream_) cudaStreamSynchronize(side_stream_->get());
     if (stream_) cudaStreamSynchronize(stream_->get());
-    // Kernels of a later backend must not record into this one's trace buffer (a destructor
-    // cannot throw: a failure leaves the pointer, and at worst a later trace's records).
-    if (trace_.capacity() > 0) {
-      try {
-        point_stream_trace(nullptr);
-      } catch (const std::exception&) {
-      }
-    }
   }
 
   std::string_view name() const override { return "cuda"; }
   std::string device_name() const override { return device_name_; }
   AheadTaken ahead_taken() const override { return ahead_taken_; }
 
-  /// The kernels record into one buffer per process (trace.cuh), pointed at by the backend
-  /// that called this last: one backend traced at a time.
   std::vector<TracedLaunch> take_stream_trace() override {
     std::vector<TracedLaunch> launches;
-    if (!stream_trace_compiled()) return launches;
-    const TraceRecord unused{0, ~0ull, ~0ull, 0, 0};
-    std::vector<TraceRecord> records(kTraceSlots, unused);
-    if (trace_.capacity() == 0) {
-      trace_.reserve(kTraceSlots);
-      point_stream_trace(trace_.data());
-    } else {
-      SNAG_CUDA_CHECK(cudaDeviceSynchronize());
-      SNAG_CUDA_CHECK(cudaMemcpy(records.data(), trace_.data(), kTraceSlots * sizeof(TraceRecord),
-                                 cudaMemcpyDeviceToHost));
-      std::erase_if(records, [](const TraceRecord& r) { return r.grid == 0; });
-      std::ranges::sort(records, {}, &TraceRecord::began);
-      const unsigned long long origin = records.empty() ? 0 : records.front().began;
-      const auto us = [&](unsigned long long ns) {
-        return static_cast<double>(ns - origin) * 1e-3;
-      };
-      for (const TraceRecord& r : records)
-        launches.push_back(
-            {static_cast<int64_t>(r.threads), us(r.began), us(r.passed_first), us(r.passed_last)});
-      records.assign(kTraceSlots, unused);
-    }
-    SNAG_CUDA_CHECK(cudaMemcpy(trace_.data(), records.data(), kTraceSlots * sizeof(TraceRecord),
-                               cudaMemcpyHostToDevice));
+    TraceRecord* const buffer = stream_trace_buffer();  // made on first use
+    if (buffer == nullptr) return launches;
+    SNAG_CUDA_CHECK(cudaDeviceSynchronize());  // every launch queued so far has recorded
+    std::vector<TraceRecord> records(kTraceSlots);
+    SNAG_CUDA_CHECK(cudaMemcpy(records.data(), buffer, kTraceSlots * sizeof(TraceRecord),
+                               cudaMemcpyDeviceToHost));
+    reset_stream_trace(buffer);
+    std::erase_if(records, [](const TraceRecord& r) { return r.grid == 0; });
+    std::ranges::sort(records, {}, &TraceRecord::began);
+    const unsigned long long origin = records.empty() ? 0 : records.front().began;
+    const auto us = [&](unsigned long long ns) { return static_cast<double>(ns - origin) * 1e-3; };
+    for (const TraceRecord& r : records)
+      launches.push_back(
+          {static_cast<int64_t>(r.threads), us(r.began), us(r.passed_first), us(r.passed_last)});
     return launches;
   }
   StageTimes last_times() const override {
@@ -842,7 +822,6 @@ class CudaBackendImpl final : public CudaBackend {
   DeviceBuffer<uint8_t> pair_status_, status_alt_;
   DeviceBuffer<unsigned char> temp_;
   DeviceBuffer<unsigned> finish_ranks_, finish_tickets_;  // FinishScratch, zero between runs
-  DeviceBuffer<TraceRecord> trace_;  // take_stream_trace's records, once it was called
   // Results in host memory: written by finish_kernel (small frames) or copied (large ones).
   PinnedBuffer<uint64_t> keys_host_, uncertain_host_;
   PinnedBuffer<uint8_t> status_host_;

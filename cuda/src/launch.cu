@@ -48,10 +48,37 @@ bool stream_trace_compiled() {
 #endif
 }
 
-void point_stream_trace([[maybe_unused]] TraceRecord* records) {
+void reset_stream_trace([[maybe_unused]] TraceRecord* records) {
 #if defined(SNAG_CUDA_TRACE)
-  point_stream_trace_detect_kernels(records);
-  point_stream_trace_device_tree(records);
+  const std::vector<TraceRecord> unused(kTraceSlots, TraceRecord{0, ~0ull, ~0ull, 0, 0});
+  SNAG_CUDA_CHECK(cudaMemcpy(records, unused.data(), kTraceSlots * sizeof(TraceRecord),
+                             cudaMemcpyHostToDevice));
+  // A copy from pageable memory may return before it lands: the next launches must find it.
+  SNAG_CUDA_CHECK(cudaDeviceSynchronize());
+#endif
+}
+
+TraceRecord* stream_trace_buffer() {
+#if defined(SNAG_CUDA_TRACE)
+  constexpr int kDevices = 64;
+  static std::mutex mutex;
+  static TraceRecord* buffers[kDevices] = {};
+  int device = 0;
+  SNAG_CUDA_CHECK(cudaGetDevice(&device));
+  if (device >= kDevices) return nullptr;
+  const std::lock_guard lock(mutex);
+  if (buffers[device] == nullptr) {
+    TraceRecord* records = nullptr;
+    SNAG_CUDA_CHECK(cudaMalloc(&records, kTraceSlots * sizeof(TraceRecord)));
+    reset_stream_trace(records);
+    point_stream_trace_detect_kernels(records);
+    point_stream_trace_device_tree(records);
+    SNAG_CUDA_CHECK(cudaDeviceSynchronize());
+    buffers[device] = records;
+  }
+  return buffers[device];
+#else
+  return nullptr;
 #endif
 }
 

@@ -4,9 +4,10 @@
 // clock (%globaltimer, nanoseconds), when its first block began (before the wait: under
 // programmatic dependent launch a kernel's blocks are scheduled while the kernel ahead of it
 // runs) and when its first and its last block got past the wait, keyed by the launch's grid
-// id. In start order, each record's first pass is where the kernel ahead of it ended: a frame's
-// kernels as the stream ran them, launch gaps and the overlap of neighbours included, which
-// ncu, timing each kernel alone, does not show (cuda/NOTES.md, "The 36K frame in the stream").
+// id. A record's first pass is about where the kernel ahead of it on its stream ended: a
+// frame's kernels as the streams ran them, launch gaps and the overlap of neighbours included,
+// which ncu, timing each kernel alone, does not show (cuda/NOTES.md, "The 36K frame in the
+// stream").
 #pragma once
 
 #include <cuda_runtime.h>
@@ -27,14 +28,20 @@ struct TraceRecord {
 /// Records kept at once, a slot per grid id modulo this: far more than the launches of a frame.
 inline constexpr int kTraceSlots = 256;
 
-/// Points every translation unit's kernels at `records` (kTraceSlots of them, device memory),
-/// or at nothing. A no-op in a build without SNAG_CUDA_TRACE.
-void point_stream_trace(TraceRecord* records);
+/// The current device's records (kTraceSlots of them), made, reset and pointed at by every
+/// translation unit's kernels on first use and kept for the process's life, so that nothing a
+/// kernel writes outlives them; null in a build without SNAG_CUDA_TRACE. One buffer per device:
+/// every backend on it records there, so one backend is traced at a time.
+TraceRecord* stream_trace_buffer();
+
+/// Sets `records` back to unused and waits until the device has them (a no-op in a build
+/// without SNAG_CUDA_TRACE).
+void reset_stream_trace(TraceRecord* records);
 
 #if defined(SNAG_CUDA_TRACE)
 /// Without relocatable device code a __device__ variable is one per translation unit, so each
 /// unit that defines kernels has its own pointer and a function of its own to set it
-/// (point_stream_trace calls them all).
+/// (stream_trace_buffer calls them all).
 static __device__ TraceRecord* g_trace_records = nullptr;
 
 __device__ __forceinline__ unsigned long long trace_clock() {
@@ -51,7 +58,10 @@ __device__ __forceinline__ void trace_launch(unsigned long long began) {
   unsigned long long grid;
   asm volatile("mov.u64 %0, %%gridid;" : "=l"(grid));
   TraceRecord& r = records[grid % kTraceSlots];
-  atomicCAS(&r.grid, 0ull, grid);
+  // A slot another launch holds (grid ids need not be consecutive): this launch is left out
+  // rather than merged into that one's record.
+  const unsigned long long holder = atomicCAS(&r.grid, 0ull, grid);
+  if (holder != 0 && holder != grid) return;
   atomicMin(&r.began, began);
   atomicMin(&r.passed_first, passed);
   atomicMax(&r.passed_last, passed);

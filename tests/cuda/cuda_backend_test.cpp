@@ -475,28 +475,32 @@ TEST(CudaBackend, StreamTraceRecordsEachKernelOfAFrameOnce) {
   for (auto& p : b.positions) p = p + geom::Vec3d{0, 0, std::fmod(p.x * 5, 2.0)};
   const detect::Topology topology =
       detect::make_topology(a.triangles, static_cast<int32_t>(a.positions.size()));
-  auto gpu = gpu_backend();
-  gpu->set_topology(topology);  // kept by reference
-  filtered(*gpu, a.positions, true);
-  EXPECT_TRUE(gpu->take_stream_trace().empty());  // the first call starts the recording
-  for (const SmallMesh* frame : {&std::as_const(b), &a}) {
-    filtered(*gpu, frame->positions, false);  // scan, refit, quality, detect
-    const std::vector<cuda::CudaBackend::TracedLaunch> launches = gpu->take_stream_trace();
-    if (!cuda::stream_trace_compiled()) {
-      EXPECT_TRUE(launches.empty()) << "a build without SNAG_CUDA_TRACE records nothing";
-      continue;
-    }
-    // The frame's ten kernels (the scan, the refit, the quality, the clearing, the walks, the
-    // subwalks, the screen, the pair tests, the expansion, the ranking), each once: only this
-    // frame's, the records of the one before taken.
-    EXPECT_EQ(launches.size(), 10u);
-    for (size_t k = 0; k < launches.size(); ++k) {
-      EXPECT_GT(launches[k].threads, 0) << k;
-      // A block passes the wait after it began; the first block before the last; and a frame
-      // takes well under a second (records left unreset would be far off).
-      EXPECT_LE(launches[k].began, launches[k].passed_first) << k;
-      EXPECT_LE(launches[k].passed_first, launches[k].passed_last) << k;
-      EXPECT_LT(launches[k].passed_last, 1e6) << k;
+  // Two backends one after the other: the records outlive the first, and the second's kernels
+  // record as its did.
+  for (int backend = 0; backend < 2; ++backend) {
+    auto gpu = gpu_backend();
+    gpu->set_topology(topology);  // kept by reference
+    filtered(*gpu, a.positions, true);
+    gpu->take_stream_trace();  // the build and what came before
+    for (const SmallMesh* frame : {&std::as_const(b), &a}) {
+      filtered(*gpu, frame->positions, false);  // scan, refit, quality, detect
+      const std::vector<cuda::CudaBackend::TracedLaunch> launches = gpu->take_stream_trace();
+      if (!cuda::stream_trace_compiled()) {
+        EXPECT_TRUE(launches.empty()) << "a build without SNAG_CUDA_TRACE records nothing";
+        continue;
+      }
+      // The frame's ten kernels, each once (the scan, the refit, the quality, the clearing, the
+      // walks, the subwalks, the screen, the pair tests, the expansion, the ranking): only this
+      // frame's, the records of the one before taken.
+      EXPECT_EQ(launches.size(), 10u) << backend;
+      for (size_t k = 0; k < launches.size(); ++k) {
+        EXPECT_GT(launches[k].threads, 0) << k;
+        // A block passes the wait after it began; the first block before the last; and a frame
+        // takes well under a second (records left unreset would be far off).
+        EXPECT_LE(launches[k].began, launches[k].passed_first) << k;
+        EXPECT_LE(launches[k].passed_first, launches[k].passed_last) << k;
+        EXPECT_LT(launches[k].passed_last, 1e6) << k;
+      }
     }
   }
 }

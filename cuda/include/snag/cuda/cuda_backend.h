@@ -88,9 +88,10 @@ class CudaBackend : public detect::Backend {
     double passed_first = 0;  ///< its first block past that wait
     double passed_last = 0;   ///< its last block past it
   };
-  /// The launches recorded since the last call, in start order (the first call starts the
-  /// recording and returns none); none in a build without SNAG_CUDA_TRACE. Waits for the device.
-  /// One backend of a process is traced at a time (the last one to call this).
+  /// The launches recorded on this backend's device since the last call (by any backend of the
+  /// process), in start order; the first call starts the recording and returns none. None in a
+  /// build without SNAG_CUDA_TRACE. Waits for the device. Every backend on a device records
+  /// into the same buffer: trace one at a time.
   virtual std::vector<TracedLaunch> take_stream_trace() = 0;
 };
 
