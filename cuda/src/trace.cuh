@@ -1,8 +1,8 @@
 // Stream tracing, for a profiling build (cmake -DSNAG_CUDA_TRACE=ON; off by default, and then
 // nothing of this is compiled into any kernel). Every kernel that starts with
-// wait_for_previous_kernel() (every one a frame chains) records there, on the device's global
-// clock (%globaltimer, nanoseconds), when its first block began (before the wait: under
-// programmatic dependent launch a kernel's blocks are scheduled while the kernel ahead of it
+// wait_for_previous_kernel() (every kernel of a frame, chained or not) records there, on the
+// device's global clock (%globaltimer, nanoseconds), when its first block began (before the wait:
+// under programmatic dependent launch a kernel's blocks are scheduled while the kernel ahead of it
 // runs) and when its first and its last block got past the wait, keyed by the launch's grid
 // id. A record's first pass is about where the kernel ahead of it on its stream ended: a
 // frame's kernels as the streams ran them, launch gaps and the overlap of neighbours included,
