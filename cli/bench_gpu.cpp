@@ -99,24 +99,24 @@ struct Row {
 /// before or after a main-stream one), told by their thread counts; how many those were.
 std::pair<std::vector<cuda::CudaBackend::TracedLaunch>, int> median_trace(
     const std::vector<std::vector<cuda::CudaBackend::TracedLaunch> >& frames) {
-  const auto order_of = [](const std::vector<cuda::CudaBackend::TracedLaunch>& frame) {
-    std::vector<int64_t> threads;
-    for (const auto& launch : frame) threads.push_back(launch.threads);
-    return threads;
-  };
+  // Each frame's order once: its launches' thread counts.
+  std::vector<std::vector<int64_t> > order_of(frames.size());
   std::map<std::vector<int64_t>, int> orders;
-  for (const auto& f : frames) ++orders[order_of(f)];
+  for (size_t f = 0; f < frames.size(); ++f) {
+    for (const auto& launch : frames[f]) order_of[f].push_back(launch.threads);
+    ++orders[order_of[f]];
+  }
   if (orders.empty()) return {{}, 0};
   const auto usual = std::ranges::max_element(orders, {}, [](const auto& o) { return o.second; });
   const std::vector<int64_t>& order = usual->first;
   std::vector<cuda::CudaBackend::TracedLaunch> medians(order.size());
   for (size_t k = 0; k < order.size(); ++k) {
     std::vector<double> began, first, last;
-    for (const auto& f : frames) {
-      if (order_of(f) != order) continue;
-      began.push_back(f[k].began);
-      first.push_back(f[k].passed_first);
-      last.push_back(f[k].passed_last);
+    for (size_t f = 0; f < frames.size(); ++f) {
+      if (order_of[f] != order) continue;
+      began.push_back(frames[f][k].began);
+      first.push_back(frames[f][k].passed_first);
+      last.push_back(frames[f][k].passed_last);
     }
     medians[k] = {order[k], median(began), median(first), median(last)};
   }

@@ -15,8 +15,8 @@
 #include "device_buffer.cuh"
 #include "device_topology.cuh"
 #include "device_tree.cuh"
-#include "launch.cuh"
 #include "snag/error.h"
+#include "trace.cuh"
 
 namespace snag::cuda {
 
