@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # One round on a GPU machine, from the repository root, with the build staged into .gpu by
 # tests/cuda/stage.sh (here: tests/cuda/stage.sh build-gpu), carried as .gpu:
-#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [accuracy] [io]
+#   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [bench-ab]
+#                           [accuracy] [io]
+# (bench-ab also needs an earlier commit's snag staged as .gpu/base/snag.)
 # Logs go to $OUT (or ./out); a short table is printed last.
 set -uo pipefail
 out=${OUT:-out}; mkdir -p "$out"
@@ -67,6 +69,21 @@ for step in "${steps[@]}"; do
       snag bench io --data "$SNAG_DATA_DIR" ${IO_ARGS:-} >"$out/bench_io.txt" 2>"$out/bench_io.err"; rc=$?
       summary+=("bench io          rc=$rc")
       ;;
+    bench-ab)
+      # The quick bench of the binary staged as .gpu/base/snag (an earlier commit's) and of this
+      # build's, alternating, twice each: side by side in one lease, as A/B comparisons need.
+      [ -x .gpu/base/snag ] || { summary+=("bench-ab          skipped: no .gpu/base/snag"); continue; }
+      for r in 1 2; do
+        for v in base new; do
+          bin=snag; [ $v = base ] && bin=.gpu/base/snag
+          timeout 200 $bin bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 1 \
+            >"$out/bench_$v$r.txt" 2>"$out/bench_$v$r.err"
+          echo "== $v$r rc=$?" >>"$out/bench_ab.txt"
+          grep -E '^(cloth|n-body)' "$out/bench_$v$r.txt" >>"$out/bench_ab.txt"
+        done
+      done
+      summary+=("bench gpu (A/B)   base and new twice each: $out/bench_ab.txt")
+      ;;
     bench-quick)
       snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
       summary+=("bench gpu (quick) rc=$rc")
@@ -75,5 +92,6 @@ for step in "${steps[@]}"; do
   summary[-1]="${summary[-1]}  [$(( $(date +%s) - t0 )) s]"
 done
 [ -f "$out/bench_gpu.txt" ] && cat "$out/bench_gpu.txt"
+[ -f "$out/bench_ab.txt" ] && cat "$out/bench_ab.txt"
 [ -f "$out/bench_io.txt" ] && cat "$out/bench_io.txt"
 printf '%s\n' "${summary[@]}"
