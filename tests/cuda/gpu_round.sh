@@ -19,8 +19,10 @@ for step in "${steps[@]}"; do
   [ $tests_rc -eq 0 ] || { summary+=("$step             skipped: the CUDA tests failed"); continue; }
   case $step in
     tests)
-      snag_cuda_tests --gtest_brief=1 >"$out/cuda_tests.log" 2>&1; rc=$?
+      # Not brief: each test's time is in the log (device time is scarce; the slowest are named).
+      snag_cuda_tests >"$out/cuda_tests.log" 2>&1; rc=$?
       summary+=("cuda tests        rc=$rc $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/cuda_tests.log" | tr '\n' ' ')")
+      summary+=("  slowest: $(grep -E '^\[       OK \]' "$out/cuda_tests.log" | sed -E 's/.*OK \] ([^ ]+) \(([0-9]+) ms\)/\2 \1/' | sort -rn | head -4 | awk '{printf "%s %.0fs; ", $2, $1/1000}')")
       tests_rc=$rc
       grep -E '^\[  FAILED  \]' "$out/cuda_tests.log" | head -20
       SNAG_EXECUTABLE=$(command -v snag) snag_cli_tests --gtest_brief=1 >"$out/cli_tests.log" 2>&1; rc=$?
