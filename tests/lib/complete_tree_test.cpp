@@ -316,15 +316,15 @@ TEST(Traversal, WalksAboveTheSplitHandOverWhatTheClimbAndTheSplitLevelsNodesGive
                             if (hand) handed.insert({p, sibling});
                           });
         // The leaf's own node of the split level: its ancestor at that level.
-        int32_t own = view.shape.leaf_at(p);
+        int32_t own = leaf;
         while (own >= 2 * split.first + 1) own = (own - 1) >> 1;
         ASSERT_TRUE(own >= split.first && own < split.first + split.count);
         // The GPU's climb stops after 6 steps, and its warp holds 64 leaves of a node.
-        ASSERT_LE(CompleteTree::level_of(view.shape.leaf_at(p)) - CompleteTree::level_of(own), 6);
+        ASSERT_LE(CompleteTree::level_of(leaf) - CompleteTree::level_of(own), 6);
         int32_t own_begin, own_end;
         view.shape.positions_under(own, own_begin, own_end);
         ASSERT_TRUE(p >= own_begin && p < own_end && own_end - own_begin <= 64);
-        const geom::Box3f box = view.boxes[view.shape.leaf_at(p)];
+        const geom::Box3f box = view.boxes[leaf];
         for (int32_t b = own + 1; b < split.first + split.count; ++b)
           if (geom::overlap(view.boxes[own], view.boxes[b]) && geom::overlap(box, view.boxes[b])) {
             handed.insert({p, b});
