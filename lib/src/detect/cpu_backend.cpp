@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "snag/bvh/leaf_lanes.h"
 #include "snag/bvh/tree.h"
 #include "snag/detect/fan.h"
+#include "snag/detect/lane_screen.h"
 #include "snag/detect/pair_test.h"
 #include "snag/detect/pairs.h"
 #include "snag/geom/narrow_phase.h"
@@ -88,26 +90,40 @@ struct WalkInput {
 /// The later leaves of a self check for the leaves under node `group` (LeafLanes::for_each_later).
 /// At each leaf the walk reaches, the lanes that share a vertex with it are found together;
 /// when every vertex is listed (no weld left some out) they are dropped at once, else lane by
-/// lane (listed_among).
+/// lane (listed_among). The other lanes' pairs with it are candidates: their rejection by sides
+/// is taken for all of them at once (LaneScreen), and only the pairs it leaves are tested.
 template <int W, FilterUse use>
 inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
   const TopologyView& view = *in.view;
+  const FrameView& frame = *in.frame;
   const bvh::LeafLanes<W> lanes(in.tree, group);
   const LaneCorners<W> corners(lanes, view.triangles + in.base);
+  // Loaded at the group's first candidate: in a settled cloth most groups meet only neighbours.
+  std::optional<LaneScreen<W>> screen;
   lanes.for_each_later(in.tree, group, [&](uint32_t overlapping, int32_t local_x) {
     const int32_t x = in.base + local_x;
     const geom::Tri xt = view.triangles[x];
-    uint32_t sharing = corners.sharing(xt);
+    const uint32_t sharing_any = corners.sharing(xt);
+    uint32_t sharing = sharing_any;
     // Most overlapping leaves are listed neighbours of every lane they overlap (94% of the
     // overlaps of a settled 36K cloth frame): they end here, after a few compares.
     if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, in.base, xt, view);
     uint32_t todo = overlapping & ~sharing;
     if (todo && in.degenerate[x]) return;
+    uint32_t separated = 0;
+    if constexpr (use == FilterUse::certify) {  // the planes exist only then
+      if (const uint32_t screened = todo & ~sharing_any) {
+        if (!screen) screen.emplace(lanes.triangle, lanes.members, frame, view.triangles, in.base);
+        separated = screen->separated(frame.positions, frame.planes[x], xt, screened);
+      }
+    }
     for (; todo; todo &= todo - 1) {
-      const int32_t t = in.base + lanes.triangle[bvh::count_trailing_zeros(todo)];
+      const int lane = bvh::count_trailing_zeros(todo);
+      const int32_t t = in.base + lanes.triangle[lane];
       if (in.degenerate[t]) continue;
       ++sink.candidates;
-      test_candidate_pair<use>(*in.frame, view, t, x, sink);
+      if (separated & (1u << lane)) continue;  // what test_candidate_pair would end with
+      test_candidate_pair<use>(frame, view, t, x, sink);
     }
   });
 }
