@@ -123,7 +123,10 @@ inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink
       if (in.degenerate[t]) continue;
       ++sink.candidates;
       if (separated & (1u << lane)) continue;  // what test_candidate_pair would end with
-      test_candidate_pair<use>(frame, view, t, x, sink);
+      if (sharing_any & (1u << lane))          // a vertex in common that is not listed (a weld)
+        test_candidate_pair<use>(frame, view, t, x, sink);
+      else
+        test_pair<use>(frame, view, t, x, 0, 0, sink);
     }
   });
 }

@@ -2,7 +2,8 @@
 // CPU's group walks (bvh::LeafLanes): when the walk reaches a leaf x, every lane of the group
 // that overlaps it and shares no vertex with it is a candidate pair (lane, x), and most such
 // pairs end at that rejection. Pair by pair it cost about as much as the walk itself on
-// cloth-ball (lib/NOTES.md); here the W pairs' twelve sides are computed together, x's corners and
+// cloth-ball (lib/NOTES.md); here the six sides of each of the W pairs are computed together
+// (the lanes' corners against x's plane, x's corners against the lanes' planes), x's corners and
 // plane loaded once, with no branch on a sign.
 //
 // The answer is separated_by_sides' bit for bit: the same roundings in the same order (no
@@ -152,6 +153,8 @@ class LaneScreen {
     return out;
   }
 
+  // 15 vectors of W doubles: 960 bytes for groups of 8, 480 for groups of 4, loaded once per
+  // group that has a candidate.
   Doubles corner_[3][3][kPacks];  ///< [corner][axis][pack]: each lane's corner positions
   Doubles minor_[3][kPacks];      ///< each lane's plane (geom::PlaneCoefficients)
   Doubles permanent_[3][kPacks];
