@@ -1,11 +1,14 @@
-// LaneScreen (the CPU walks' rejection by sides, several lanes a vector) against the pair-by-pair
-// rejection it replaces, pair_passes_sides, on pairs that share no vertex: random triangles,
+// LaneScreen (the CPU walks' rejection by sides and test of segments apart, several lanes a
+// vector) against the pair-by-pair tests it stands for, pair_passes_sides and
+// test_pair_given_shared, on pairs that share no vertex: random triangles,
 // triangles on one slanted plane up to rounding (sides within a few units in the last place of
 // zero, on both sides of the filter's bound), exact zeros (integer coordinates, repeated points
 // under other ids), coordinates whose differences underflow, and a query below the bound's
 // range. Groups of 8 are also run compiled for AVX2, as the walks run them, where the CPU has it.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <random>
 #include <vector>
 
@@ -15,38 +18,42 @@ namespace snag::test {
 namespace {
 
 #if defined(__x86_64__) && defined(__GNUC__)
-/// LaneScreen<8>::separated compiled for AVX2 and inlined whole, as cpu_backend.cpp's
+/// LaneScreen<8>::settle compiled for AVX2 and inlined whole, as cpu_backend.cpp's
 /// walk_group_avx2 runs it (the test binary itself is built for the baseline).
-[[gnu::target("avx2"), gnu::flatten]] uint32_t separated_avx2(const detect::LaneScreen<8>& screen,
-                                                              const geom::Vec3d* positions,
-                                                              const geom::PlaneCoefficients& plane,
-                                                              const geom::Tri& xt,
-                                                              uint32_t wanted) {
-  return screen.separated(positions, plane, xt, wanted);
+[[gnu::target("avx2"), gnu::flatten]] detect::LaneScreen<8>::Settled settle_avx2(
+    const detect::LaneScreen<8>& screen, const geom::Vec3d* positions,
+    const geom::PlaneCoefficients& plane, const geom::Tri& xt, uint32_t wanted) {
+  return screen.settle(positions, plane, xt, wanted);
 }
 bool cpu_has_avx2() {
   return __builtin_cpu_supports("avx2");
 }
 #else
-uint32_t separated_avx2(const detect::LaneScreen<8>&, const geom::Vec3d*,
-                        const geom::PlaneCoefficients&, const geom::Tri&, uint32_t) {
-  return 0;
+detect::LaneScreen<8>::Settled settle_avx2(const detect::LaneScreen<8>&, const geom::Vec3d*,
+                                           const geom::PlaneCoefficients&, const geom::Tri&,
+                                           uint32_t) {
+  return {};
 }
 bool cpu_has_avx2() {
   return false;
 }
 #endif
 
-/// A frame of loose triangles: its positions, triangles and their planes.
+/// A frame of loose triangles: its positions, triangles and their planes, each triangle
+/// representing a random subset of its own three edges.
 struct LooseTriangles {
   std::vector<geom::Vec3d> positions;
   std::vector<geom::Tri> triangles;
+  std::vector<std::array<int32_t, 3>> triangle_edges;
+  std::vector<uint8_t> owned_edges;
   std::vector<geom::PlaneCoefficients> planes;
 
   void add(geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) {
     const int32_t first = static_cast<int32_t>(positions.size());
     positions.insert(positions.end(), {a, b, c});
     triangles.push_back({{first, first + 1, first + 2}});
+    triangle_edges.push_back({first, first + 1, first + 2});
+    owned_edges.push_back(static_cast<uint8_t>(owned_edges.size() * 5 % 8));
   }
   detect::FrameView frame() {
     planes.clear();
@@ -57,21 +64,40 @@ struct LooseTriangles {
   detect::TopologyView topology() const {
     detect::TopologyView view{};
     view.triangles = triangles.data();
+    view.triangle_edges = triangle_edges.data();
+    view.owned_edges = owned_edges.data();
     view.triangle_count = static_cast<int32_t>(triangles.size());
+    view.edge_count = 3 * view.triangle_count;
     return view;
   }
 };
 
+/// What the pair test reports, counted.
+struct CountingSink {
+  int hits = 0, uncertain_tests = 0, misses = 0, duplicates = 0;
+  void hit(int32_t, int32_t) { ++hits; }
+  void uncertain(int32_t, int32_t) { ++uncertain_tests; }
+  void miss() { ++misses; }
+  void duplicate(int32_t, int32_t) { ++duplicates; }
+};
+
+/// How many wanted pairs the screen settled, of each kind.
+struct SettledCounts {
+  int64_t separated = 0, apart = 0, left = 0;
+};
+
 /// Every triangle in turn as x, against groups of W of the others (lanes filled in order, the
 /// last group short when the count does not divide), with one lane of each group left out of
-/// `wanted` at random: each wanted lane's bit must be what the pair-by-pair test answers, and
-/// no other lane's bit set. Returns how many wanted pairs were separated.
+/// `wanted` at random. For each wanted lane: separated exactly when the pair-by-pair rejection
+/// (pair_passes_sides) says so; apart only where the whole pair test (test_pair_given_shared)
+/// reports a miss for every edge either triangle represents and nothing else. No other lane's
+/// bit set; groups of 8 compiled for AVX2 give the same bits.
 template <int W>
-int64_t expect_same_as_pair_by_pair(LooseTriangles& loose, std::mt19937& rng) {
+SettledCounts expect_same_as_pair_by_pair(LooseTriangles& loose, std::mt19937& rng) {
   const detect::FrameView frame = loose.frame();
   const detect::TopologyView topo = loose.topology();
   const int32_t n = static_cast<int32_t>(loose.triangles.size());
-  int64_t separated_count = 0;
+  SettledCounts counts;
   for (int32_t x = 0; x < n; ++x) {
     std::vector<int32_t> others;
     for (int32_t t = 0; t < n; ++t)
@@ -84,28 +110,42 @@ int64_t expect_same_as_pair_by_pair(LooseTriangles& loose, std::mt19937& rng) {
       const detect::LaneScreen<W> screen(lane_triangle, members, frame, topo.triangles, 0);
       uint32_t wanted = (1u << members) - 1u;
       wanted &= ~(1u << std::uniform_int_distribution<int>(0, W)(rng));
-      const uint32_t bits =
-          screen.separated(frame.positions, frame.planes[x], topo.triangles[x], wanted);
+      const auto settled =
+          screen.settle(frame.positions, frame.planes[x], topo.triangles[x], wanted);
       if constexpr (W == 8) {
-        if (cpu_has_avx2())
-          EXPECT_EQ(
-              separated_avx2(screen, frame.positions, frame.planes[x], topo.triangles[x], wanted),
-              bits)
-              << "AVX2 against the baseline build, x " << x;
+        if (cpu_has_avx2()) {
+          const auto avx2 =
+              settle_avx2(screen, frame.positions, frame.planes[x], topo.triangles[x], wanted);
+          EXPECT_EQ(avx2.separated, settled.separated) << "AVX2 against the baseline, x " << x;
+          EXPECT_EQ(avx2.apart, settled.apart) << "AVX2 against the baseline, x " << x;
+        }
       }
-      EXPECT_EQ(bits & ~wanted, 0u) << "lanes not wanted";
+      EXPECT_EQ((settled.separated | settled.apart) & ~wanted, 0u) << "lanes not wanted";
+      EXPECT_EQ(settled.separated & settled.apart, 0u) << "separated and apart";
       for (int lane = 0; lane < members; ++lane) {
         if (!(wanted & (1u << lane))) continue;
         const int32_t t = lane_triangle[lane];
-        const bool expected = !detect::pair_passes_sides(frame, topo, t, x, 0, 0);
-        EXPECT_EQ((bits >> lane) & 1u, expected ? 1u : 0u)
+        const bool separated = !detect::pair_passes_sides(frame, topo, t, x, 0, 0);
+        EXPECT_EQ((settled.separated >> lane) & 1u, separated ? 1u : 0u)
             << "W " << W << ", triangle " << t << " against " << x;
-        if (::testing::Test::HasFailure()) return separated_count;
-        separated_count += expected;
+        if ((settled.apart >> lane) & 1u) {
+          CountingSink sink;
+          detect::test_pair_given_shared(frame, topo, t, x, 0, 0, sink);
+          EXPECT_EQ(sink.hits + sink.uncertain_tests + sink.duplicates, 0)
+              << "apart, but the pair test reports more than misses: W " << W << ", triangle " << t
+              << " against " << x;
+          EXPECT_EQ(sink.misses, std::popcount(topo.owned_edges[t] & 7u) +
+                                     std::popcount(topo.owned_edges[x] & 7u))
+              << "W " << W << ", triangle " << t << " against " << x;
+        }
+        if (::testing::Test::HasFailure()) return counts;
+        counts.separated += separated;
+        counts.apart += (settled.apart >> lane) & 1u;
+        counts.left += !separated && !((settled.apart >> lane) & 1u);
       }
     }
   }
-  return separated_count;
+  return counts;
 }
 
 template <int W>
@@ -116,8 +156,11 @@ void check_all_cases() {
     std::uniform_real_distribution<double> coord(-1.0, 1.0);
     auto point = [&] { return geom::Vec3d{coord(rng), coord(rng), coord(rng)}; };
     for (int i = 0; i < 120; ++i) loose.add(point(), point(), point());
-    const int64_t separated = expect_same_as_pair_by_pair<W>(loose, rng);
-    EXPECT_GT(separated, 0);
+    // Every outcome occurs: separated, apart, and left to the pair test (some of those meet).
+    const SettledCounts counts = expect_same_as_pair_by_pair<W>(loose, rng);
+    EXPECT_GT(counts.separated, 0);
+    EXPECT_GT(counts.apart, 0);
+    EXPECT_GT(counts.left, 0);
   }
   {  // Small integers: exact zeros everywhere (coplanar corners, points on planes), which the
      // filter leaves uncertain and which must never count as separating.
@@ -166,6 +209,20 @@ void check_all_cases() {
     }
     expect_same_as_pair_by_pair<W>(loose, rng);
   }
+  {  // One corner of each triangle on x = 0 or x = 1e-310: the two lone corners of a pair often
+     // differ by a subnormal, a difference whose products may underflow (not safe_difference),
+     // which leaves the segments' order uncertain however clear it looks.
+    LooseTriangles loose;
+    std::uniform_real_distribution<double> coord(-1.0, 1.0);
+    std::bernoulli_distribution tiny(0.5);
+    auto point = [&] { return geom::Vec3d{coord(rng), coord(rng), coord(rng)}; };
+    for (int i = 0; i < 160; ++i) {
+      geom::Vec3d snapped = point();
+      snapped.x = tiny(rng) ? 1e-310 : 0.0;
+      loose.add(snapped, point(), point());
+    }
+    expect_same_as_pair_by_pair<W>(loose, rng);
+  }
   {  // A corner within 2^-900 of the other's plane origin: the query's permanent is below the
      // bound's range, so that side is uncertain however clear its sign looks.
     LooseTriangles loose;
@@ -176,11 +233,11 @@ void check_all_cases() {
   }
 }
 
-TEST(LaneScreen, FourLanesAnswerAsThePairByPairRejection) {
+TEST(LaneScreen, FourLanesAnswerAsThePairByPairTests) {
   check_all_cases<4>();
 }
 
-TEST(LaneScreen, EightLanesAnswerAsThePairByPairRejection) {
+TEST(LaneScreen, EightLanesAnswerAsThePairByPairTests) {
   check_all_cases<8>();
 }
 

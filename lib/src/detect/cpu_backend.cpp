@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <optional>
 
@@ -110,11 +111,11 @@ inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink
     if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, in.base, xt, view);
     uint32_t todo = overlapping & ~sharing;
     if (todo && in.degenerate[x]) return;
-    uint32_t separated = 0;
+    typename LaneScreen<W>::Settled settled;
     if constexpr (use == FilterUse::certify) {  // the planes exist only then
       if (const uint32_t screened = todo & ~sharing_any) {
         if (!screen) screen.emplace(lanes.triangle, lanes.members, frame, view.triangles, in.base);
-        separated = screen->separated(frame.positions, frame.planes[x], xt, screened);
+        settled = screen->settle(frame.positions, frame.planes[x], xt, screened);
       }
     }
     for (; todo; todo &= todo - 1) {
@@ -122,7 +123,14 @@ inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink
       const int32_t t = in.base + lanes.triangle[lane];
       if (in.degenerate[t]) continue;
       ++sink.candidates;
-      if (separated & (1u << lane)) continue;  // what test_candidate_pair would end with
+      // What test_pair would end with: nothing to report, or a miss for each edge tested (every
+      // edge either triangle represents: they share no vertex).
+      if (settled.separated & (1u << lane)) continue;
+      if (settled.apart & (1u << lane)) {
+        sink.misses +=
+            std::popcount(view.owned_edges[t] & 7u) + std::popcount(view.owned_edges[x] & 7u);
+        continue;
+      }
       if (sharing_any & (1u << lane))          // a vertex in common that is not listed (a weld)
         test_candidate_pair<use>(frame, view, t, x, sink);
       else
