@@ -88,15 +88,51 @@ struct WalkInput {
   const uint8_t* degenerate = nullptr;
 };
 
+/// The candidate pairs of the group's lanes in `todo` with triangle x (not degenerate), which
+/// the walk reached: their rejection by sides and the test of segments apart are taken for all
+/// of them at once (LaneScreen::settle, `screen` loaded at the group's first use), and only the
+/// pairs it leaves get the pair test. Lanes in `sharing` have a vertex of x (a weld left it
+/// unlisted): the screen assumes none, so they get the whole pair test.
+template <int W, FilterUse use>
+inline void test_lanes_against(const WalkInput& in, const bvh::LeafLanes<W>& lanes,
+                               std::optional<LaneScreen<W>>& screen, uint32_t todo,
+                               uint32_t sharing, int32_t x, const geom::Tri& xt, ThreadSink& sink) {
+  const TopologyView& view = *in.view;
+  const FrameView& frame = *in.frame;
+  typename LaneScreen<W>::Settled settled;
+  if constexpr (use == FilterUse::certify) {  // the planes exist only then
+    if (const uint32_t screened = todo & ~sharing) {
+      if (!screen) screen.emplace(lanes.triangle, lanes.members, frame, view.triangles, in.base);
+      settled = screen->settle(frame.positions, frame.planes[x], xt, screened);
+    }
+  }
+  for (; todo; todo &= todo - 1) {
+    const int lane = bvh::count_trailing_zeros(todo);
+    const int32_t t = in.base + lanes.triangle[lane];
+    if (in.degenerate[t]) continue;
+    ++sink.candidates;
+    // What test_pair would end with: nothing to report, or a miss for each edge tested (every
+    // edge either triangle represents: they share no vertex).
+    if (settled.separated & (1u << lane)) continue;
+    if (settled.apart & (1u << lane)) {
+      sink.misses +=
+          std::popcount(view.owned_edges[t] & 7u) + std::popcount(view.owned_edges[x] & 7u);
+      continue;
+    }
+    if (sharing & (1u << lane))
+      test_candidate_pair<use>(frame, view, t, x, sink);
+    else
+      test_pair<use>(frame, view, t, x, 0, 0, sink);
+  }
+}
+
 /// The later leaves of a self check for the leaves under node `group` (LeafLanes::for_each_later).
 /// At each leaf the walk reaches, the lanes that share a vertex with it are found together;
 /// when every vertex is listed (no weld left some out) they are dropped at once, else lane by
-/// lane (listed_among). The other lanes' pairs with it are candidates: their rejection by sides
-/// is taken for all of them at once (LaneScreen), and only the pairs it leaves are tested.
+/// lane (listed_among). The other lanes' pairs with it are candidates (test_lanes_against).
 template <int W, FilterUse use>
 inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
   const TopologyView& view = *in.view;
-  const FrameView& frame = *in.frame;
   const bvh::LeafLanes<W> lanes(in.tree, group);
   const LaneCorners<W> corners(lanes, view.triangles + in.base);
   // Loaded at the group's first candidate: in a settled cloth most groups meet only neighbours.
@@ -109,45 +145,26 @@ inline void walk_self_group(const WalkInput& in, int32_t group, ThreadSink& sink
     // Most overlapping leaves are listed neighbours of every lane they overlap (94% of the
     // overlaps of a settled 36K cloth frame): they end here, after a few compares.
     if (!view.every_vertex_listed) sharing = listed_among(sharing, lanes, in.base, xt, view);
-    uint32_t todo = overlapping & ~sharing;
-    if (todo && in.degenerate[x]) return;
-    typename LaneScreen<W>::Settled settled;
-    if constexpr (use == FilterUse::certify) {  // the planes exist only then
-      if (const uint32_t screened = todo & ~sharing_any) {
-        if (!screen) screen.emplace(lanes.triangle, lanes.members, frame, view.triangles, in.base);
-        settled = screen->settle(frame.positions, frame.planes[x], xt, screened);
-      }
-    }
-    for (; todo; todo &= todo - 1) {
-      const int lane = bvh::count_trailing_zeros(todo);
-      const int32_t t = in.base + lanes.triangle[lane];
-      if (in.degenerate[t]) continue;
-      ++sink.candidates;
-      // What test_pair would end with: nothing to report, or a miss for each edge tested (every
-      // edge either triangle represents: they share no vertex).
-      if (settled.separated & (1u << lane)) continue;
-      if (settled.apart & (1u << lane)) {
-        sink.misses +=
-            std::popcount(view.owned_edges[t] & 7u) + std::popcount(view.owned_edges[x] & 7u);
-        continue;
-      }
-      if (sharing_any & (1u << lane))          // a vertex in common that is not listed (a weld)
-        test_candidate_pair<use>(frame, view, t, x, sink);
-      else
-        test_pair<use>(frame, view, t, x, 0, 0, sink);
-    }
+    const uint32_t todo = overlapping & ~sharing;
+    if (!todo || in.degenerate[x]) return;
+    test_lanes_against<W, use>(in, lanes, screen, todo, sharing_any, x, xt, sink);
   });
 }
 
-/// The leaves under node `group` of in.tree against every leaf of in.other (two parts share no
-/// vertex: every overlap is a candidate).
+/// The leaves under node `group` of in.tree against every leaf of in.other: two parts share no
+/// vertex, so every overlap is a candidate (test_lanes_against; the lanes sharing one are still
+/// looked for, at the cost of a few compares, so that nothing rests on that).
 template <int W, FilterUse use>
 inline void walk_between_group(const WalkInput& in, int32_t group, ThreadSink& sink) {
-  bvh::for_each_overlap_grouped<W>(in.tree, group, in.other, [&](int32_t local_t, int32_t local_x) {
-    const int32_t t = in.base + local_t, x = in.other_base + local_x;
-    if (in.degenerate[t] || in.degenerate[x]) return;
-    ++sink.candidates;
-    test_candidate_pair<use>(*in.frame, *in.view, t, x, sink);
+  const TopologyView& view = *in.view;
+  const bvh::LeafLanes<W> lanes(in.tree, group);
+  const LaneCorners<W> corners(lanes, view.triangles + in.base);
+  std::optional<LaneScreen<W>> screen;
+  lanes.walk_leaves(in.other, 0, [&](uint32_t overlapping, int32_t local_x) {
+    const int32_t x = in.other_base + local_x;
+    if (in.degenerate[x]) return;
+    const geom::Tri xt = view.triangles[x];
+    test_lanes_against<W, use>(in, lanes, screen, overlapping, corners.sharing(xt), x, xt, sink);
   });
 }
 
@@ -188,9 +205,7 @@ bool cpu_has_avx2() {
 class CpuBackend final : public Backend {
  public:
   CpuBackend(int threads, CpuWalkWidth width)
-      : threads_(thread_count(threads)),
-        wide_(cpu_walk_lanes(width) == 8),
-        avx2_(cpu_has_avx2()) {}
+      : threads_(thread_count(threads)), wide_(cpu_walk_lanes(width) == 8), avx2_(cpu_has_avx2()) {}
 
   std::string_view name() const override { return "cpu"; }
 

@@ -159,12 +159,6 @@ struct LeafLanes {
     };
   }
 
-  /// walk_leaves, calling visit(lane triangle, leaf's triangle) for each overlapping lane.
-  template <class Visit>
-  void walk(const TreeView& tree, int32_t root, Visit&& visit) const {
-    walk_leaves(tree, root, each_lane(visit));
-  }
-
   /// The query of for_each_later_overlap for every member at once (this group's node is
   /// `group`): calls visit_leaf(lane_bits, other_triangle) for every later leaf, with a bit for
   /// each member whose box overlaps it, so that each unordered pair is visited once. Pairs of
@@ -190,15 +184,6 @@ template <int W, class Visit>
 inline void for_each_later_overlap_grouped(TreeView tree, int32_t group, Visit&& visit) {
   const LeafLanes<W> lanes(tree, group);
   lanes.for_each_later(tree, group, lanes.each_lane(visit));
-}
-
-/// for_each_overlap for the (up to W) leaves under node `group` of `tree` (for_each_group_under)
-/// against every leaf of `other`: calls visit(member_triangle, other_triangle) for every pair
-/// whose boxes overlap.
-template <int W, class Visit>
-inline void for_each_overlap_grouped(TreeView tree, int32_t group, TreeView other, Visit&& visit) {
-  const LeafLanes<W> lanes(tree, group);
-  lanes.walk(other, 0, visit);
 }
 
 }  // namespace snag::bvh
