@@ -234,6 +234,8 @@ class LaneScreen {
     const Longs above_low_negative = (flip & low_above) | (~flip & low_below);
     const Longs below_high_positive = (flip & high_below) | (~flip & high_above);
     // There: apart when J_high < I_low; else, once that sign is certain, when J_low > I_high.
+    // Here only signs the filter certifies count: where plane_side_rare would find an exact
+    // zero there (segments touching), the lane is left to the pair test.
     return bits(strict & (above_low_negative | ((low_above | low_below) & below_high_positive)));
   }
 
