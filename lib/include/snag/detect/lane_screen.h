@@ -14,12 +14,8 @@
 #pragma once
 
 #include <cstdint>
-#include <cstring>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
+#include "snag/bvh/leaf_lanes.h"
 #include "snag/detect/pair_test.h"
 #include "snag/geom/predicates.h"
 
@@ -69,8 +65,8 @@ class LaneScreen {
         corner_[k][0][q][i] = p.x;
         corner_[k][1][q][i] = p.y;
         corner_[k][2][q][i] = p.z;
-        minor_[k][q][i] = present ? frame.planes[t].minor[k] : 0.0;
-        permanent_[k][q][i] = present ? frame.planes[t].permanent[k] : 0.0;
+        minor_[q][k][i] = present ? frame.planes[t].minor[k] : 0.0;
+        permanent_[q][k][i] = present ? frame.planes[t].permanent[k] : 0.0;
       }
     }
   }
@@ -104,24 +100,24 @@ class LaneScreen {
       }
       settled.separated |= alike_bits(t_above[q], t_below[q]) << (V * q);
     }
+    settled.separated &= wanted;
     uint32_t left = wanted & ~settled.separated;
-    if (left == 0) return done(settled, wanted);
+    if (left == 0) return settled;
     // x's corners against the lanes' planes: rows x_j - corner 0 (sides_against(x, t)).
     const geom::Vec3d x1 = positions[xt.v[1]], x2 = positions[xt.v[2]];
     const geom::Vec3d x_corner[3] = {x0, x1, x2};
     Longs x_above[kPacks][3], x_below[kPacks][3];
     for (int q = 0; q < kPacks; ++q) {
       if (((left >> (V * q)) & kPackBits) == 0) continue;
-      const Doubles lane_minor[3] = {minor_[0][q], minor_[1][q], minor_[2][q]};
-      const Doubles lane_permanent[3] = {permanent_[0][q], permanent_[1][q], permanent_[2][q]};
       for (int j = 0; j < 3; ++j) {
         const geom::Vec3d& d = x_corner[j];
         const Doubles row[3] = {d.x - corner_[0][0][q], d.y - corner_[0][1][q],
                                 d.z - corner_[0][2][q]};
-        side(row, lane_minor, lane_permanent, x_above[q][j], x_below[q][j]);
+        side(row, minor_[q], permanent_[q], x_above[q][j], x_below[q][j]);
       }
       settled.separated |= alike_bits(x_above[q], x_below[q]) << (V * q);
     }
+    settled.separated &= wanted;
     left = wanted & ~settled.separated;
     for (int q = 0; q < kPacks; ++q) {
       if (((left >> (V * q)) & kPackBits) == 0) continue;
@@ -129,13 +125,7 @@ class LaneScreen {
                        << (V * q);
     }
     settled.apart &= left;
-    return done(settled, wanted);
-  }
-
-  /// settle(...).separated: a bit per lane of `wanted` whose pair with xt is separated by sides.
-  uint32_t separated(const geom::Vec3d* positions, const geom::PlaneCoefficients& x_plane,
-                     const geom::Tri& xt, uint32_t wanted) const {
-    return settle(positions, x_plane, xt, wanted).separated;
+    return settled;
   }
 
  private:
@@ -162,7 +152,7 @@ class LaneScreen {
 
   /// A bit per lane whose three corners lie certainly on one side: separated (no corner shared).
   static uint32_t alike_bits(const Longs (&above)[3], const Longs (&below)[3]) {
-    return bits((above[0] & above[1] & above[2]) | (below[0] & below[1] & below[2]));
+    return bvh::lane_bits((above[0] & above[1] & above[2]) | (below[0] & below[1] & below[2]));
   }
 
   /// A triangle's corners from its lone one on (fi or xj there), lane by lane: out[i] is
@@ -236,7 +226,8 @@ class LaneScreen {
     // There: apart when J_high < I_low; else, once that sign is certain, when J_low > I_high.
     // Here only signs the filter certifies count: where plane_side_rare would find an exact
     // zero there (segments touching), the lane is left to the pair test.
-    return bits(strict & (above_low_negative | ((low_above | low_below) & below_high_positive)));
+    return bvh::lane_bits(strict &
+                          (above_low_negative | ((low_above | low_below) & below_high_positive)));
   }
 
   /// plane_side_filter(PlaneCoefficients::of(a, b, c), a, d) lane by lane: `above` / `below`
@@ -269,32 +260,11 @@ class LaneScreen {
     return axis == 0 ? p.x : (axis == 1 ? p.y : p.z);
   }
 
-  static Settled done(Settled settled, uint32_t wanted) {
-    settled.separated &= wanted;
-    settled.apart &= wanted;
-    return settled;
-  }
-
-  /// Bit i set for each of the V lanes whose mask is all ones (two lanes a 16-byte piece).
-  static uint32_t bits(const Longs& mask) {
-    uint32_t out = 0;
-#if defined(__SSE2__)
-    for (int piece = 0; piece < V / 2; ++piece) {
-      __m128d pair;
-      std::memcpy(&pair, reinterpret_cast<const char*>(&mask) + 16 * piece, sizeof pair);
-      out |= static_cast<uint32_t>(_mm_movemask_pd(pair)) << (2 * piece);
-    }
-#else
-    for (int lane = 0; lane < V; ++lane) out |= static_cast<uint32_t>(mask[lane] & 1) << lane;
-#endif
-    return out;
-  }
-
   // 15 vectors of W doubles: 960 bytes for groups of 8, 480 for groups of 4, loaded once per
   // group that has a candidate.
   Doubles corner_[3][3][kPacks];  ///< [corner][axis][pack]: each lane's corner positions
-  Doubles minor_[3][kPacks];      ///< each lane's plane (geom::PlaneCoefficients)
-  Doubles permanent_[3][kPacks];
+  Doubles minor_[kPacks][3];      ///< [pack][k]: each lane's plane (geom::PlaneCoefficients)
+  Doubles permanent_[kPacks][3];
 };
 
 }  // namespace snag::detect
