@@ -1,10 +1,11 @@
 // The text readers' number parsing (lib/src/io/text_scan.h): parse_double's fast path must give
 // exactly what fast_float gives, value, bits and where the number ends, and accept and reject
 // exactly the same tokens; glibc's strtod (correctly rounded) is the independent reference for
-// the values.
+// the values. parse_integer's digit loop must give what std::from_chars gives.
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -54,6 +55,81 @@ TEST(TextScan, CoordinatesParseAsFastFloatAndStrtodWhateverTheirDigits) {
     expect_as_fast_float(token + ends[pick(rng)]);
   }
   EXPECT_GT(fast, 50000);  // the fast path was taken often
+}
+
+/// Random text after a token: digits, points, signs, blanks, letters, NUL and bytes whose top
+/// bits are set, so that whatever a parser reads past the token, or stops at, is there.
+std::string random_tail(std::mt19937& rng) {
+  static const char kBytes[] = {'0',
+                                '5',
+                                '9',
+                                '.',
+                                '-',
+                                '+',
+                                ' ',
+                                '\n',
+                                '\r',
+                                'e',
+                                'x',
+                                '/',
+                                ':',
+                                '\0',
+                                static_cast<char>(0xFA),
+                                static_cast<char>(0xFF),
+                                static_cast<char>(0x80),
+                                static_cast<char>(0x2F)};
+  std::uniform_int_distribution<int> length(0, 24), pick(0, sizeof kBytes - 1);
+  std::string tail(static_cast<size_t>(length(rng)), ' ');
+  for (char& c : tail) c = kBytes[pick(rng)];
+  return tail;
+}
+
+// Tokens inside a text, as in a file: what follows a number's end is any text, not the text's
+// end (the test above ends most tokens there).
+TEST(TextScan, CoordinatesFollowedByAnyTextParseAsFastFloat) {
+  std::mt19937 rng(20261202);
+  std::uniform_int_distribution<int> digit(0, 9), integer_digits(0, 9), fraction_digits(0, 9),
+      pick(0, 4);
+  const char* const ends[] = {" ", "\n", "\r\n", "", "\t1"};
+  for (int i = 0; i < 300000; ++i) {
+    std::string token;
+    if (pick(rng) < 2) token += '-';
+    const int whole = integer_digits(rng);
+    for (int d = 0; d < whole; ++d) token += static_cast<char>('0' + digit(rng));
+    const bool point = pick(rng) > 0;
+    const int fraction = point ? fraction_digits(rng) : 0;
+    if (point) token += '.';
+    for (int d = 0; d < fraction; ++d) token += static_cast<char>('0' + digit(rng));
+    expect_as_fast_float(token + ends[pick(rng)] + random_tail(rng));
+  }
+}
+
+/// parse_integer against std::from_chars: the value, where it ends and whether it failed.
+void expect_as_from_chars(const std::string& text) {
+  const char* first = text.data();
+  const char* end = text.data() + text.size();
+  int64_t ours = -7, theirs = -7;
+  const auto a = snag::io::detail::parse_integer(first, end, ours);
+  const auto b = std::from_chars(first, end, theirs);
+  ASSERT_EQ(a.ec, b.ec) << "'" << text << "'";
+  ASSERT_EQ(a.ptr, b.ptr) << "'" << text << "'";
+  if (b.ec == std::errc()) ASSERT_EQ(ours, theirs) << "'" << text << "'";
+}
+
+TEST(TextScan, IndicesParseAsFromChars) {
+  std::mt19937 rng(1202);
+  std::uniform_int_distribution<int> digit(0, 9), digits(0, 21), pick(0, 3);
+  for (int i = 0; i < 300000; ++i) {
+    std::string token;
+    if (pick(rng) == 0) token += '-';
+    const int count = digits(rng);
+    for (int d = 0; d < count; ++d) token += static_cast<char>('0' + digit(rng));
+    expect_as_from_chars(token + random_tail(rng));
+  }
+  for (const char* text :
+       {"0", "7 ", "12345678", "1234567 ", "12345678 1", "99999999999999999999",
+        "9223372036854775807 ", "9223372036854775808        ", "-1 2 3 4 5 6", "00000001/2/3"})
+    expect_as_from_chars(text);
 }
 
 TEST(TextScan, TokensThatAreNotPlainDecimalsGoToFastFloat) {
