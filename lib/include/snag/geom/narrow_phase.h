@@ -231,8 +231,16 @@ SNAG_HD Answer is_crossing_given_sides(const P& pred, const Tri& f, const Tri& x
   if (fi < 0 || xi < 0) return Answer::no;  // coplanar or not straddling both ways
   const int32_t f0 = f.v[fi], f1 = f.v[(fi + 1) % 3], f2 = f.v[(fi + 2) % 3];
   const int32_t x0 = x.v[xi], x1 = x.v[(xi + 1) % 3], x2 = x.v[(xi + 2) % 3];
-  const Sign order[4] = {pred.orient3d(f0, f1, x0, x1), pred.orient3d(f0, f1, x0, x2),
-                         pred.orient3d(f0, f2, x0, x1), pred.orient3d(f0, f2, x0, x2)};
+  // Two planes asked twice each (plane(a, b, c).side(d) is orient3d(a, b, c, d), with half the
+  // coefficients computed); when I1 lies strictly between J1 and J2, the first plane's two
+  // signs already differ and the second is not needed.
+  const auto plane_1 = pred.plane(f0, f1, x0);
+  const Sign order_1[2] = {plane_1.side(x1), plane_1.side(x2)};
+  if ((order_1[0] == Sign::positive && order_1[1] == Sign::negative) ||
+      (order_1[0] == Sign::negative && order_1[1] == Sign::positive))
+    return Answer::yes;
+  const auto plane_2 = pred.plane(f0, f2, x0);
+  const Sign order[4] = {order_1[0], order_1[1], plane_2.side(x1), plane_2.side(x2)};
   bool positive = false, negative = false, uncertain = false;
   for (Sign s : order) {
     positive |= s == Sign::positive;
