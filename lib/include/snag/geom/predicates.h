@@ -34,7 +34,15 @@ constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 // Below this permanent, products may have underflowed and the relative bound no longer holds.
 constexpr double kMinPermanent = 0x1p-900;
 // About twenty times the largest error (3 * 2^-1075) that underflow in the three final products
-// of a query can add to its determinant and its permanent.
+// of a query can add to its determinant and its permanent. With a permanent of at least
+// kMinPermanent the bound kOrient3dBound * perm is at least 2^-951, so this term rounds away in
+// the sum; what covers the underflow there is that det and the rounded bound are both doubles:
+// |det| > bound means |det| >= bound + ulp(bound) >= bound + 2^-1003, far more than 2^-1073.
+// (An error up to `bound` is what the relative bound covers without underflow; the products
+// of the plane's coefficients cannot underflow, see PlaneCoefficients::of; the three products
+// of the query row can, each by at most 2^-1075 in the determinant and in the permanent, and
+// sums whose result is subnormal are exact.) The term is kept for bounds that do not round it
+// away, and it only ever makes the filter more cautious.
 constexpr double kUnderflowSlack = 0x1p-1069;
 // A difference this large or exactly zero keeps every product of three of them normal.
 constexpr double kMinDifference = 0x1p-300;
@@ -54,6 +62,8 @@ SNAG_HD_INLINE Sign orient2d(double ax, double ay, double bx, double by, double 
   const double left = acx * bcy, right = acy * bcx;
   const double det = left - right;
   const double permanent = fabs(left) + fabs(right);
+  // A product that underflowed is off by at most 2^-1075: covered, as in orient3d, by the
+  // strict comparison of two doubles (see kUnderflowSlack).
   if (permanent >= detail::kMinPermanent && fabs(det) > detail::kOrient2dBound * permanent)
     return detail::sign_of(det);
   // Both products exactly zero because a difference is exactly zero: the determinant is zero.
