@@ -36,21 +36,32 @@ void expect_as_fast_float(const std::string& text) {
       << "'" << token << "'";
 }
 
+/// A random plain decimal: '-' two times in five, 0 to `most_whole` integer digits, and four
+/// times in five a point with 0 to `most_fraction` digits after it; `whole` and `fraction`
+/// receive the digit counts.
+std::string random_decimal(std::mt19937& rng, int most_whole, int most_fraction, int& whole,
+                           int& fraction) {
+  std::uniform_int_distribution<int> digit(0, 9), integer_digits(0, most_whole),
+      fraction_digits(0, most_fraction), pick(0, 4);
+  std::string token;
+  if (pick(rng) < 2) token += '-';
+  whole = integer_digits(rng);
+  for (int d = 0; d < whole; ++d) token += static_cast<char>('0' + digit(rng));
+  const bool point = pick(rng) > 0;
+  fraction = point ? fraction_digits(rng) : 0;
+  if (point) token += '.';
+  for (int d = 0; d < fraction; ++d) token += static_cast<char>('0' + digit(rng));
+  return token;
+}
+
 TEST(TextScan, CoordinatesParseAsFastFloatAndStrtodWhateverTheirDigits) {
   std::mt19937 rng(20261124);
-  std::uniform_int_distribution<int> digit(0, 9), integer_digits(0, 17), fraction_digits(0, 25),
-      pick(0, 4);
+  std::uniform_int_distribution<int> pick(0, 4);
   const char* const ends[] = {" ", "\n", "\r\n", "", "\t1"};
   int fast = 0;
   for (int i = 0; i < 200000; ++i) {
-    std::string token;
-    if (pick(rng) < 2) token += '-';
-    const int whole = integer_digits(rng);
-    for (int d = 0; d < whole; ++d) token += static_cast<char>('0' + digit(rng));
-    const bool point = pick(rng) > 0;
-    const int fraction = point ? fraction_digits(rng) : 0;
-    if (point) token += '.';
-    for (int d = 0; d < fraction; ++d) token += static_cast<char>('0' + digit(rng));
+    int whole, fraction;
+    const std::string token = random_decimal(rng, 17, 25, whole, fraction);
     fast += whole + fraction >= 1 && whole + fraction <= 15;
     expect_as_fast_float(token + ends[pick(rng)]);
   }
@@ -73,18 +84,11 @@ std::string random_tail(std::mt19937& rng) {
 // the digits are any of those bytes; the others by a blank or a line end first.
 TEST(TextScan, CoordinatesFollowedByAnyTextParseAsFastFloat) {
   std::mt19937 rng(20261202);
-  std::uniform_int_distribution<int> digit(0, 9), integer_digits(0, 9), fraction_digits(0, 9),
-      pick(0, 4);
+  std::uniform_int_distribution<int> pick(0, 4);
   const char* const ends[] = {" ", "\n", "\r\n", "", "\t1"};
   for (int i = 0; i < 300000; ++i) {
-    std::string token;
-    if (pick(rng) < 2) token += '-';
-    const int whole = integer_digits(rng);
-    for (int d = 0; d < whole; ++d) token += static_cast<char>('0' + digit(rng));
-    const bool point = pick(rng) > 0;
-    const int fraction = point ? fraction_digits(rng) : 0;
-    if (point) token += '.';
-    for (int d = 0; d < fraction; ++d) token += static_cast<char>('0' + digit(rng));
+    int whole, fraction;
+    const std::string token = random_decimal(rng, 9, 9, whole, fraction);
     const bool direct = pick(rng) < 2;
     expect_as_fast_float(token + (direct ? "" : ends[pick(rng)]) + random_tail(rng));
   }

@@ -5,6 +5,7 @@
 #include <fast_float/fast_float.h>
 
 #include <charconv>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -39,15 +40,23 @@ inline bool ends_token(const char* ptr, const char* end) {
   return ptr == end || is_blank_or_eol(*ptr);
 }
 
+/// The ASCII digits from `p` on, at most `most` of them and none at or past `end`, appended to
+/// `value` (value * 10 + digit each); returns where they stop. One bound for both the text's
+/// end and the count: a compare a digit fewer, and the caller's counts come from the pointers
+/// (a coordinate digit's step was fourteen instructions with three counters, now nine).
+inline const char* append_digits(const char* p, const char* end, std::ptrdiff_t most,
+                                 uint64_t& value) {
+  const char* const limit = end - p > most ? p + most : end;
+  for (; p < limit && static_cast<unsigned char>(*p - '0') < 10; ++p)
+    value = value * 10 + static_cast<unsigned>(*p - '0');
+  return p;
+}
+
 /// std::from_chars for an integer (an index, a count), with a plain digit loop for the usual
 /// case of at most 18 digits (no overflow possible), which is about twice as fast.
 inline std::from_chars_result parse_integer(const char* first, const char* end, int64_t& value) {
-  const char* q = first;
-  // One bound for both the text's end and the 18 digits: a compare a digit fewer.
-  const char* const limit = end - first > 18 ? first + 18 : end;
   uint64_t v = 0;
-  for (; q < limit && static_cast<unsigned char>(*q - '0') < 10; ++q)
-    v = v * 10 + static_cast<unsigned>(*q - '0');
+  const char* const q = append_digits(first, end, 18, v);
   if (q > first && (q == end || static_cast<unsigned char>(*q - '0') >= 10)) {
     value = static_cast<int64_t>(v);
     return {q, std::errc()};
@@ -69,22 +78,14 @@ inline fast_float::from_chars_result parse_double(const char* first, const char*
   const char* q = first;
   const bool negative = q < end && *q == '-';
   q += negative;
-  // At most 16 digits are read in all (one more than the path takes): each loop runs up to one
-  // bound, the text's end or the 16th digit, whichever comes first, and the counts come from
-  // the pointers (a digit's step was fourteen instructions with three counters, now nine).
+  // At most 16 digits are read in all, one more than the path takes.
   uint64_t mantissa = 0;
   const char* const whole_begin = q;
-  const char* limit = end - q > 16 ? q + 16 : end;
-  for (; q < limit && static_cast<unsigned char>(*q - '0') < 10; ++q)
-    mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+  q = append_digits(q, end, 16, mantissa);
   int digits = static_cast<int>(q - whole_begin), fraction = 0;
   if (q < end && *q == '.') {
-    ++q;
-    const char* const fraction_begin = q;
-    const int room = 16 - digits;
-    limit = end - q > room ? q + room : end;
-    for (; q < limit && static_cast<unsigned char>(*q - '0') < 10; ++q)
-      mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
+    const char* const fraction_begin = q + 1;
+    q = append_digits(fraction_begin, end, 16 - digits, mantissa);
     fraction = static_cast<int>(q - fraction_begin);
     digits += fraction;
   }
