@@ -288,10 +288,10 @@ class WarpLister {
   unsigned count_ = 0;  // the same in every lane
 };
 
-/// Up to this many nodes at the split level (trees of up to 131,072 leaves), a self check's walks
-/// above that level run a warp per node (self_split_walk_kernel); above it, a thread per leaf
-/// (self_walk_kernel), whose chains are then spread over enough threads.
-inline constexpr int32_t kSplitWarpNodes = 2048;
+// Up to bvh::kSplitWarpNodes nodes at the split level (trees of up to 131,072 leaves), a self
+// check's walks above that level run a warp per node (self_split_walk_kernel); above it, a
+// thread per leaf (self_walk_kernel), whose chains are then spread over enough threads.
+using bvh::kSplitWarpNodes;
 
 /// The later nodes of the split level a warp collects before testing its leaves against them.
 inline constexpr int kLaterChunk = 128;

@@ -4,6 +4,7 @@
 // inverse): about 52 (56) bytes per triangle.
 #pragma once
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -144,16 +145,24 @@ SNAG_HD_INLINE void for_each_later_overlapping_leaf(TreeView tree, int32_t posit
   }
 }
 
+/// Up to this many nodes at the split level (split_walk_level), the GPU walks above that level
+/// a warp per node, testing the level's nodes all against all (2M box tests at most); above it,
+/// a thread per leaf.
+inline constexpr int32_t kSplitWarpNodes = 2048;
+/// The deepest level with at most kSplitWarpNodes nodes.
+inline constexpr int32_t kSplitWarpLevel =
+    std::bit_width(static_cast<uint32_t>(kSplitWarpNodes)) - 1;
+
 /// The level at which a GPU splits each leaf's walk in two (the walks above it, then one
 /// walk under each overlapping node of it): five levels above the deepest (nodes of 16 to 32
-/// leaves) while that level has at most 2^11 nodes (trees of up to 65,536 leaves), else six
-/// (32 to 64 leaves). The GPU walks above a level of at most 2,048 nodes a warp per node
-/// (kSplitWarpNodes); five levels gave a settled 36K cloth frame (depth 16) 0.131 -> 0.128 ms
-/// on an H200, and 2,244 triangles 0.081-0.082 -> 0.076-0.078, where cloth-ball (depth 17) at
-/// five would have 4,096 nodes there and walk a thread per leaf, 7% slower (cuda/NOTES.md).
+/// leaves) while that level has at most kSplitWarpNodes nodes (trees of up to 65,536 leaves),
+/// else six (32 to 64 leaves). Five levels gave a settled 36K cloth frame (depth 16) 0.131 ->
+/// 0.128 ms on an H200, and 2,244 triangles 0.081-0.082 -> 0.076-0.078, where cloth-ball (depth
+/// 17) at five would have 4,096 nodes there and walk a thread per leaf, 7% slower
+/// (cuda/NOTES.md).
 SNAG_HD_INLINE int32_t split_walk_level(const CompleteTree& shape) {
   if (shape.depth <= 5) return 0;
-  return shape.depth - (shape.depth - 5 <= 11 ? 5 : 6);
+  return shape.depth - (shape.depth - 5 <= kSplitWarpLevel ? 5 : 6);
 }
 
 /// The nodes of level `level`: [first, first + count), 2^level of them (levels 0 to D - 1 are
