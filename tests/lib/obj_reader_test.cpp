@@ -76,6 +76,66 @@ TEST(ObjReader, CoordinatesParsedExactly) {
   EXPECT_EQ(m.positions[2].y, 1e-300);
 }
 
+// Long enough that every number is read by the columns' usual layouts (parse_shaped and
+// parse_shaped_index need 16 to 18 bytes ahead): each column's format changes now and then
+// (fixed decimals of several widths, integers, exponents, '+'), and every coordinate must be
+// strtod's value of its token, every index the one written.
+TEST(ObjReader, CoordinatesInChangingLayoutsParsedExactly) {
+  std::mt19937 rng(20261202);
+  std::uniform_real_distribution<double> coordinate(-2000.0, 2000.0);
+  std::uniform_int_distribution<int> pick(0, 99), format(0, 6);
+  const char* const formats[] = {"%.6f", "%.3f", "%.0f", "%.9f", "%g", "%+.4f", "%.17g"};
+  std::string text;
+  std::vector<std::string> tokens;
+  int layout[3] = {0, 0, 0};
+  const int vertices = 3000;
+  for (int i = 0; i < vertices; ++i) {
+    text += "v";
+    for (int k = 0; k < 3; ++k) {
+      if (pick(rng) < 5) layout[k] = format(rng);
+      char token[64];
+      std::snprintf(token, sizeof token, formats[layout[k]], coordinate(rng));
+      tokens.push_back(token);
+      text += (pick(rng) < 10 ? "  " : " ") + tokens.back();
+    }
+    text += pick(rng) < 10 ? " \r\n" : "\n";
+  }
+  std::uniform_int_distribution<int> corner(1, vertices);
+  Tris expected;
+  for (int i = 0; i < 3000; ++i) {
+    const int a = corner(rng), b = corner(rng), c = corner(rng);
+    text += "f " + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(c) + "\n";
+    expected.push_back({a - 1, b - 1, c - 1});
+  }
+  const mesh::Mesh m = read_obj(text, "t.obj");
+  ASSERT_EQ(m.positions.size(), static_cast<size_t>(vertices));
+  for (int i = 0; i < vertices; ++i) {
+    const Vec3d& p = m.positions[static_cast<size_t>(i)];
+    const double xyz[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      const std::string& token = tokens[static_cast<size_t>(3 * i + k)];
+      ASSERT_EQ(xyz[k], std::strtod(token.c_str(), nullptr)) << "vertex " << i << ": " << token;
+    }
+  }
+  EXPECT_EQ(tris(m), expected);
+}
+
+// A token spoiled in the middle of a long file, after its column's layout is settled, is still
+// rejected at its line.
+TEST(ObjReader, RejectsNonNumbersAmongNumbersOfOneLayout) {
+  std::string lines;
+  for (int i = 0; i < 50; ++i) lines += "v 1.000000 -2.000000 3.000000\n";
+  const std::string tail = "v 1.000000 -2.000000 3.000000\nf 1 2 3\n";
+  for (const char* bad : {"-2.00x000", "-2.000.00", "-2.0000000x", "-2.000000\x01", "--2.000000"}) {
+    expect_rejected(lines + "v 1.000000 " + bad + " 3.000000\n" + tail, 51, "found '");
+  }
+  std::string faces = lines;
+  for (int i = 0; i < 20; ++i) faces += "f 11 12 13\n";
+  expect_rejected(faces + "f 11 1x 13\n" + tail, 71, "'1x'");
+  expect_rejected(faces + "f 11 12 60\n" + tail, 71, "out of range");
+  expect_rejected(faces + "f 11 12 0\n" + tail, 71, "is 0");
+}
+
 TEST(ObjReader, AllCornerForms) {
   const std::string text =
       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"

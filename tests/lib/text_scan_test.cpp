@@ -94,6 +94,116 @@ TEST(TextScan, CoordinatesFollowedByAnyTextParseAsFastFloat) {
   }
 }
 
+/// parse_shaped on the start of `text`, with the column's `shape` carried from the call before:
+/// when it reads the token, the value's bits and the token's end must be parse_double's (which
+/// the tests above hold to fast_float's and strtod's), and a blank or a line end must follow.
+/// Returns whether it read the token.
+bool expect_shaped_as_parse_double(const std::string& text, snag::io::detail::DecimalShape& shape) {
+  const char* first = text.data();
+  const char* end = text.data() + text.size();
+  double ours = -7.0, theirs = -7.0;
+  const char* after = nullptr;
+  if (!snag::io::detail::parse_shaped(first, end, shape, ours, after)) return false;
+  const auto b = parse_double(first, end, theirs);
+  EXPECT_EQ(b.ec, std::errc()) << "'" << text << "'";
+  EXPECT_EQ(after, b.ptr) << "'" << text << "'";
+  EXPECT_EQ(std::bit_cast<uint64_t>(ours), std::bit_cast<uint64_t>(theirs)) << "'" << text << "'";
+  EXPECT_TRUE(after < end && snag::io::detail::is_blank_or_eol(*after)) << "'" << text << "'";
+  return true;
+}
+
+// A column of coordinates as a writer prints it: one layout most of the time (the shape
+// parse_shaped expects), now and then another, and now and then the token spoiled by one byte
+// (a digit made another byte; a digit added; the blank after it made another byte), each followed
+// by a blank or line end and any text. Every token parse_shaped takes must be parse_double's, and
+// the unspoiled tokens of the usual layout must be taken.
+TEST(TextScan, ShapedCoordinatesParseAsParseDouble) {
+  std::mt19937 rng(20261202);
+  std::uniform_int_distribution<int> pick(0, 99), digit(0, 9), layout_digits(0, 9);
+  // Around each class's edges: digits ('/' ':'), blanks ('\b' '\x0e' on either side of '\t' to
+  // '\r'), and NUL, DEL, bytes above 0x7f.
+  static const char kSpoilers[] = "0.e/:-+ \b\x0e\x01\x7f\x80\xff";  // and NUL
+  std::uniform_int_distribution<int> spoiler(0, sizeof kSpoilers - 1);
+  const char* const ends[] = {" ", "\n", "\r\n", "\t", "\v", "\f"};
+  std::uniform_int_distribution<int> pick_end(0, 5);
+  for (int column = 0; column < 200; ++column) {
+    snag::io::detail::DecimalShape shape;
+    int whole = layout_digits(rng), fraction = layout_digits(rng);
+    bool point = pick(rng) < 80;
+    int usual = 0, usual_taken = 0, taken = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const int roll = pick(rng);
+      if (roll < 3) {  // the writer's layout changes
+        whole = layout_digits(rng);
+        fraction = layout_digits(rng);
+        point = pick(rng) < 80;
+      }
+      std::string token = pick(rng) < 40 ? "-" : "";
+      for (int d = 0; d < whole; ++d) token += static_cast<char>('0' + digit(rng));
+      if (point) token += '.';
+      for (int d = 0; d < (point ? fraction : 0); ++d) token += static_cast<char>('0' + digit(rng));
+      std::string after = ends[pick_end(rng)];
+      const bool spoiled = roll >= 3 && roll < 13;
+      if (spoiled) {
+        const int how = pick(rng) % 3;
+        if (how == 0 && !token.empty())
+          token[static_cast<size_t>(pick(rng)) % token.size()] = kSpoilers[spoiler(rng)];
+        else if (how == 1)
+          token += static_cast<char>('0' + digit(rng));
+        else
+          after = std::string(1, kSpoilers[spoiler(rng)]);
+      }
+      const std::string text = token + after + random_tail(rng) + std::string(24, 'x');
+      const bool took = expect_shaped_as_parse_double(text, shape);
+      if (::testing::Test::HasFailure()) return;
+      taken += took;
+      // The usual layout, unspoiled and in the fast path's reach, after one token to learn it.
+      const int length = whole + (point ? 1 + fraction : 0);
+      if (!spoiled && roll >= 13 && i > 0 && whole + (point ? fraction : 0) > 0 && whole <= 8 &&
+          (point ? fraction : 0) <= 8 && length <= 15) {
+        ++usual;
+        usual_taken += took;
+      }
+    }
+    EXPECT_GE(usual_taken, usual * 9 / 10) << "column " << column;
+    EXPECT_GT(taken, 0);
+  }
+}
+
+TEST(TextScan, ShapedCoordinatesLeaveShortTextsAndOtherTokensToParseDouble) {
+  snag::io::detail::DecimalShape shape;
+  double value = 0;
+  const char* after = nullptr;
+  const std::string pad(24, ' ');
+  // Too close to the end of the text: not read, whatever the shape.
+  const std::string short_text = "1.5 2.5 3.5";
+  EXPECT_FALSE(snag::io::detail::parse_shaped(
+      short_text.data(), short_text.data() + short_text.size(), shape, value, after));
+  for (const char* token : {"1e5", "+1.5", "--1", "1.2.3", ".", "-", "123456789.5", "1.123456789",
+                            "0x10", "nan", "1,5", "5/6"}) {
+    const std::string text = token + pad;
+    // With the shape of "1.5" known, and with none.
+    for (const char* learned : {"1.5", ""}) {
+      shape = {};
+      if (*learned) {
+        const std::string first = learned + pad;
+        ASSERT_TRUE(snag::io::detail::parse_shaped(first.data(), first.data() + first.size(), shape,
+                                                   value, after));
+      }
+      EXPECT_FALSE(snag::io::detail::parse_shaped(text.data(), text.data() + text.size(), shape,
+                                                  value, after))
+          << token;
+    }
+  }
+  double zero = 1.0;
+  shape = {};
+  const std::string negative_zero = "-0.000000" + pad;
+  ASSERT_TRUE(snag::io::detail::parse_shaped(
+      negative_zero.data(), negative_zero.data() + negative_zero.size(), shape, zero, after));
+  EXPECT_TRUE(std::signbit(zero));
+  EXPECT_EQ(zero, 0.0);
+}
+
 /// parse_integer against std::from_chars: the value, where it ends and whether it failed.
 void expect_as_from_chars(const std::string& text) {
   const char* first = text.data();
@@ -120,6 +230,58 @@ TEST(TextScan, IndicesParseAsFromChars) {
        {"0", "7 ", "12345678", "1234567 ", "12345678 1", "99999999999999999999",
         "9223372036854775807 ", "9223372036854775808        ", "-1 2 3 4 5 6", "00000001/2/3"})
     expect_as_from_chars(text);
+}
+
+// A column of indices: one length most of the time, now and then another (1 to 10 digits, so
+// that some are past the 8 parse_shaped_index reads), and now and then one spoiled by a byte
+// (a digit made another byte, or the byte after the run made a digit). Each run it reads must be
+// parse_integer's, value and end; the unspoiled runs of up to 8 digits must all be read.
+TEST(TextScan, ShapedIndicesParseAsParseInteger) {
+  std::mt19937 rng(1203);
+  std::uniform_int_distribution<int> pick(0, 99), digit(0, 9), run_length(1, 10);
+  static const char kSpoilers[] = "0/:- \n\x01\x7f\x80\xff";  // and NUL
+  std::uniform_int_distribution<int> spoiler(0, sizeof kSpoilers - 1);
+  for (int column = 0; column < 200; ++column) {
+    uint8_t length = 0;
+    int digits = run_length(rng), plain = 0, plain_taken = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const int roll = pick(rng);
+      if (roll < 3) digits = run_length(rng);
+      std::string token;
+      for (int d = 0; d < digits; ++d) token += static_cast<char>('0' + digit(rng));
+      std::string after = pick(rng) < 50 ? " " : "\n";
+      const bool spoiled = roll >= 3 && roll < 13;
+      if (spoiled) {
+        if (pick(rng) < 50)
+          token[static_cast<size_t>(pick(rng)) % token.size()] = kSpoilers[spoiler(rng)];
+        else
+          after = std::string(1, static_cast<char>('0' + digit(rng)));
+      }
+      const std::string text = token + after + random_tail(rng) + std::string(16, 'x');
+      const char* first = text.data();
+      const char* end = first + text.size();
+      uint64_t ours = 0;
+      const char* read = snag::io::detail::parse_shaped_index(first, end, length, ours);
+      if (read) {
+        int64_t theirs = -1;
+        const auto b = snag::io::detail::parse_integer(first, end, theirs);
+        ASSERT_EQ(b.ec, std::errc()) << "'" << text << "'";
+        ASSERT_EQ(read, b.ptr) << "'" << text << "'";
+        ASSERT_EQ(static_cast<int64_t>(ours), theirs) << "'" << text << "'";
+      }
+      if (!spoiled && digits <= 8) {
+        ++plain;
+        plain_taken += read != nullptr;
+      }
+    }
+    EXPECT_EQ(plain_taken, plain) << "column " << column;
+  }
+  uint8_t length = 0;
+  uint64_t value = 0;
+  const std::string short_text = "12 13 14";
+  EXPECT_EQ(snag::io::detail::parse_shaped_index(
+                short_text.data(), short_text.data() + short_text.size(), length, value),
+            nullptr);
 }
 
 TEST(TextScan, TokensThatAreNotPlainDecimalsGoToFastFloat) {

@@ -1,5 +1,6 @@
 // OBJ parsing from one in-memory buffer: one pass, no per-line allocation, numbers through
-// detail::parse_double (fast_float behind a fast path) and detail::parse_integer. Only `v`,
+// detail::parse_shaped and parse_shaped_index (each column's usual layout, read without a
+// loop), else detail::parse_double (fast_float behind a fast path) and parse_integer. Only `v`,
 // `f`, `o` and `g` are looked at; every other line costs one memchr to find its end.
 #include "snag/io/obj_reader.h"
 
@@ -144,6 +145,7 @@ class ObjParser {
         fail("vertex has " + std::to_string(k) + " coordinate" + (k == 1 ? "" : "s") +
              "; expected 3 numbers (x y z)");
       }
+      if (detail::parse_shaped(p_, end_, shapes_[k], xyz[k], p_)) continue;
       const char* start = p_;
       const char* first = detail::past_plus(p_, end_);
       auto [ptr, ec] = detail::parse_double(first, end_, xyz[k]);
@@ -172,6 +174,13 @@ class ObjParser {
     for (int k = 0; k < 3; ++k) {
       if (q == end_ || *q != ' ') return false;
       while (q < end_ && *q == ' ') ++q;
+      uint64_t shaped = 0;
+      if (const char* after = detail::parse_shaped_index(q, end_, index_lengths_[k], shaped)) {
+        if (shaped == 0 || shaped > static_cast<uint64_t>(listed)) return false;
+        q = after;
+        corner[k] = static_cast<int32_t>(shaped - 1);
+        continue;
+      }
       int64_t index = 0;
       const auto [after, ec] = detail::parse_integer(q, end_, index);
       if (ec != std::errc() || after == q || index <= 0 || index > listed) return false;
@@ -291,6 +300,8 @@ class ObjParser {
   int64_t line_ = 1;
   mesh::Mesh mesh_;
   std::vector<int32_t> corners_;  // reused for every face: no allocation per line
+  detail::DecimalShape shapes_[3];  // the x, y and z columns' last layouts (parse_shaped)
+  uint8_t index_lengths_[3] = {};   // plain triangles' corner columns (parse_shaped_index)
   std::vector<ForwardReference> forward_;
   std::string_view pending_name_;
   bool group_pending_ = false;

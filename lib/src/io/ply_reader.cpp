@@ -709,6 +709,8 @@ class AsciiBody {
         continue;
       }
       const char* start = skip_to_token(el, i);
+      // A plain decimal of at most 8 + 8 digits, in range of a float: nothing to check.
+      if (detail::parse_shaped(start, end_, shapes_[axis], xyz[axis], p_)) continue;
       // The number is parsed straight from the text and must end its token, so that each
       // character is read once.
       const char* first = detail::past_plus(start, end_);
@@ -769,6 +771,7 @@ class AsciiBody {
   mesh::Mesh mesh_;
   std::vector<int32_t> corners_;
   StructureReuse reuse_;
+  detail::DecimalShape shapes_[3];  // the x, y and z columns' last layouts (parse_shaped)
 };
 
 mesh::Mesh parse_ply(std::string_view bytes, const std::string& name_for_errors,

@@ -11,6 +11,10 @@
 #include <string>
 #include <system_error>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace snag::io::detail {
 
 /// Blanks inside a line. '\r' counts as one so that CRLF files need no special case.
@@ -94,6 +98,135 @@ inline fast_float::from_chars_result parse_double(const char* first, const char*
   const double magnitude = static_cast<double>(mantissa) / kPowersOfTen[fraction];
   value = negative ? -magnitude : magnitude;
   return {q, std::errc()};
+}
+
+/// The layout of a plain decimal token, [-]W[.F] (W and F runs of digits): how parse_shaped
+/// expects the next token of a column to look, as masks over the 16 bytes after the sign. A
+/// writer prints a column in one format ("%f": -1.131931), so the layout of the last token is
+/// nearly always that of the next, and the token's end is known before its bytes are looked
+/// at: the next token's parse does not wait for this one's (a byte loop's end, or a mask's
+/// first non-digit, is a chain of dependent steps that it would wait for).
+struct DecimalShape {
+  uint32_t window = 0;  ///< the token's bytes and the one after it
+  uint32_t digits = 0;  ///< which of them are digits
+  uint32_t dot = 0;     ///< the '.', when there is one
+  uint8_t whole = 0, fraction = 0, length = 0;
+  bool known = false;
+};
+
+/// Eight or fewer ASCII digits as a number: `chunk` holds them from its lowest byte on, `count`
+/// of them (1 to 8), whatever follows. SWAR: the digits shifted to the top bytes (the bytes
+/// below are zero digits), then pairs, fours and eights combined by multiplications.
+inline uint64_t eight_digits_value(uint64_t chunk, int count) {
+  uint64_t v = (chunk - 0x3030303030303030ull) << (8 * (8 - count));
+  v = v * 10 + (v >> 8);  // each even byte: two digits' value (the odd bytes are junk)
+  v = (((v & 0x000000ff000000ffull) * (100 + (1000000ull << 32))) +
+       (((v >> 16) & 0x000000ff000000ffull) * (1 + (10000ull << 32)))) >>
+      32;
+  return v;
+}
+
+/// parse_double's plain path for a token laid out as `shape` says, read without a loop: the
+/// bytes' classes (digit, '.', blank or line end) as bit masks from one 16-byte load, compared
+/// with the shape's; the digits' value from two 8-byte loads. When the token is not so laid out
+/// but is a plain decimal of up to 8 + 8 digits that fits in the 16 bytes, `shape` becomes its
+/// layout and it is read the same way. Returns false, with nothing changed but `shape`, for any
+/// other token or when fewer than 18 bytes are left (the loads reach 17 bytes past a sign);
+/// then parse_double decides. On true, `value`
+/// is parse_double's value bit for bit (the same mantissa divided by the same power of ten)
+/// and `after` the token's end, which is followed by a blank or a line end.
+inline bool parse_shaped(const char* first, const char* end, DecimalShape& shape, double& value,
+                         const char*& after) {
+#if defined(__SSE2__)
+  static constexpr double kPowersOfTen[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8};
+  static constexpr uint64_t kPowers[] = {1,      10,      100,      1000,     10000,
+                                         100000, 1000000, 10000000, 100000000};
+  if (end - first < 18) return false;
+  const bool negative = *first == '-';
+  const char* const q = first + negative;
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+  const __m128i less_zero = _mm_sub_epi8(bytes, _mm_set1_epi8('0'));
+  const auto digit = static_cast<uint32_t>(
+      _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(less_zero, _mm_set1_epi8(9)), less_zero)));
+  const auto dot =
+      static_cast<uint32_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(bytes, _mm_set1_epi8('.'))));
+  // is_blank_or_eol: ' ', or '\t' '\n' '\v' '\f' '\r' (9 to 13).
+  const __m128i less_tab = _mm_sub_epi8(bytes, _mm_set1_epi8('\t'));
+  const auto blank = static_cast<uint32_t>(_mm_movemask_epi8(
+      _mm_or_si128(_mm_cmpeq_epi8(bytes, _mm_set1_epi8(' ')),
+                   _mm_cmpeq_epi8(_mm_min_epu8(less_tab, _mm_set1_epi8(4)), less_tab))));
+  if (!shape.known || (digit & shape.window) != shape.digits || (dot & shape.window) != shape.dot ||
+      !((blank >> shape.length) & 1)) {
+    // Another layout: this token's own, if it is a plain decimal that fits.
+    const int whole = __builtin_ctz(~digit);
+    const int has_dot = (dot >> whole) & 1;
+    const int fraction = has_dot ? __builtin_ctz(~(digit >> (whole + 1))) : 0;
+    const int length = whole + has_dot + fraction;
+    if (whole > 8 || fraction > 8 || whole + fraction == 0 || whole + fraction > 15 ||
+        length > 15 || !((blank >> length) & 1)) {
+      shape.known = false;
+      return false;
+    }
+    shape.whole = static_cast<uint8_t>(whole);
+    shape.fraction = static_cast<uint8_t>(fraction);
+    shape.length = static_cast<uint8_t>(length);
+    shape.window = (2u << length) - 1;
+    shape.digits = ((1u << whole) - 1) | (((1u << fraction) - 1) << (whole + 1));
+    shape.dot = has_dot ? 1u << whole : 0;
+    shape.known = true;
+  }
+  uint64_t mantissa = 0;
+  if (shape.whole) {
+    uint64_t chunk;
+    std::memcpy(&chunk, q, 8);
+    mantissa = eight_digits_value(chunk, shape.whole);
+  }
+  if (shape.fraction) {
+    uint64_t chunk;
+    std::memcpy(&chunk, q + shape.whole + 1, 8);
+    mantissa = mantissa * kPowers[shape.fraction] + eight_digits_value(chunk, shape.fraction);
+  }
+  const double magnitude = static_cast<double>(mantissa) / kPowersOfTen[shape.fraction];
+  value = negative ? -magnitude : magnitude;
+  after = q + shape.length;
+  return true;
+#else
+  (void)first, (void)end, (void)shape, (void)value, (void)after;
+  return false;
+#endif
+}
+
+/// parse_shaped's counterpart for an index of 1 to 8 digits, its column's last length in
+/// `length` (0: none yet): the digit run at `first` read from one 16-byte mask and one 8-byte
+/// load when its length is the expected one, else measured on the mask. Returns the run's end
+/// (a non-digit, not looked at further) with its value in `value`, or nullptr, with nothing
+/// changed but `length`, when the run is empty or longer than 8 digits or fewer than 16 bytes
+/// are left; then parse_integer decides. The value is parse_integer's.
+inline const char* parse_shaped_index(const char* first, const char* end, uint8_t& length,
+                                      uint64_t& value) {
+#if defined(__SSE2__)
+  if (end - first < 16) return nullptr;
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(first));
+  const __m128i less_zero = _mm_sub_epi8(bytes, _mm_set1_epi8('0'));
+  const auto digit = static_cast<uint32_t>(
+      _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(less_zero, _mm_set1_epi8(9)), less_zero)));
+  // The expected length's digits and a non-digit after them.
+  if (length == 0 || (digit & ((2u << length) - 1)) != (1u << length) - 1) {
+    const int run = __builtin_ctz(~digit);
+    if (run == 0 || run > 8) {
+      length = 0;
+      return nullptr;
+    }
+    length = static_cast<uint8_t>(run);
+  }
+  uint64_t chunk;
+  std::memcpy(&chunk, first, 8);
+  value = eight_digits_value(chunk, length);
+  return first + length;
+#else
+  (void)first, (void)end, (void)length, (void)value;
+  return nullptr;
+#endif
 }
 
 /// The whitespace-delimited token starting at `p`, quoted, shortened past 40 characters so that
