@@ -39,6 +39,24 @@ inline int32_t part_of(const detect::PartLayout& layout, int32_t t) {
   return p;
 }
 
+/// Scenes with a part that has no triangles (an obstacle file without faces), no vertices or a
+/// few, first, between or last; the last scene has nothing else. Checked with every part pair.
+inline std::vector<Laid> scenes_with_an_empty_part() {
+  const SmallMesh cloth = folded_grid(12, 5), body = lattice_soup(40, 30, 4, 2);
+  SmallMesh nothing, points;
+  points.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  return {lay_end_to_end({cloth, nothing, body}), lay_end_to_end({cloth, points}),
+          lay_end_to_end({nothing, cloth}), lay_end_to_end({points})};
+}
+
+/// Every pair of a scene's parts, itself included.
+inline std::vector<detect::PartCheck> every_check(const Laid& laid) {
+  std::vector<detect::PartCheck> checks;
+  for (int32_t a = 0; a < laid.layout.part_count(); ++a)
+    for (int32_t b = a; b < laid.layout.part_count(); ++b) checks.push_back({a, b});
+  return checks;
+}
+
 /// The brute-force pairs of the whole mesh whose parts are checked together.
 inline std::vector<detect::FacePair> expected_pairs(const Laid& laid,
                                                     const std::vector<detect::PartCheck>& checks) {

@@ -743,6 +743,31 @@ TEST(CudaScene, ScenesMatchWhenEveryBufferOverflows) {
   expect_scene_matches(1);
 }
 
+// A part without triangles (an obstacle file without faces) has an empty tree on the GPU too.
+TEST(CudaScene, APartWithoutTrianglesMatchesTheCpu) {
+  SNAG_REQUIRE_GPU();
+  auto resolver = std::make_shared<IntegerResolver>();
+  for (const Laid& scene : scenes_with_an_empty_part()) {
+    const std::vector<detect::PartCheck> checks = every_check(scene);
+    detect::Checker gpu(gpu_backend(), resolver), cpu(detect::make_cpu_backend(2), resolver);
+    for (detect::Checker* c : {&gpu, &cpu})
+      c->set_scene(scene.mesh.triangles, static_cast<int32_t>(scene.mesh.positions.size()),
+                   scene.layout, checks);
+    Laid frame = scene;
+    for (int f = 0; f < 3; ++f) {
+      for (geom::Vec3d& p : frame.mesh.positions) p = p + geom::Vec3d{0.0, 0.0, double(f % 2)};
+      const detect::FrameResult g = gpu.check(frame.mesh.positions);
+      const detect::FrameResult c = cpu.check(frame.mesh.positions);
+      EXPECT_EQ(g.pairs, c.pairs) << scene.layout.part_count() << " parts, frame " << f;
+      EXPECT_EQ(g.pairs, expected_pairs(frame, checks))
+          << scene.layout.part_count() << " parts, frame " << f;
+      ASSERT_EQ(g.checks.size(), c.checks.size());
+      for (size_t k = 0; k < g.checks.size(); ++k)
+        EXPECT_EQ(g.checks[k].pairs, c.checks[k].pairs) << "frame " << f << " check " << k;
+    }
+  }
+}
+
 TEST(CudaBackend, BadDeviceIsAnError) {
   SNAG_REQUIRE_GPU();
   EXPECT_THROW(cuda::make_cuda_backend(cuda::cuda_device_count()), snag::InternalError);

@@ -52,6 +52,27 @@ TEST(SceneCheck, PairsAreTheBruteForcePairsOfTheChecksAsked) {
   }
 }
 
+// A part without triangles has an empty tree: its checks find nothing and the others run as
+// usual, frame after frame, while the parts with triangles move.
+TEST(SceneCheck, APartWithoutTrianglesChecksAsEmpty) {
+  for (const Laid& scene : scenes_with_an_empty_part()) {
+    const std::vector<detect::PartCheck> checks = every_check(scene);
+    for (int threads : {1, 2}) {
+      auto checker = make_checker(threads);
+      checker->set_scene(scene.mesh.triangles, static_cast<int32_t>(scene.mesh.positions.size()),
+                         scene.layout, checks);
+      Laid frame = scene;
+      for (int f = 0; f < 3; ++f) {
+        for (geom::Vec3d& p : frame.mesh.positions) p = p + geom::Vec3d{0.0, 0.0, double(f % 2)};
+        const detect::FrameResult result = checker->check(frame.mesh.positions);
+        ASSERT_EQ(result.pairs, expected_pairs(frame, checks))
+            << scene.layout.part_count() << " parts, frame " << f;
+        ASSERT_EQ(result.checks.size(), checks.size());
+      }
+    }
+  }
+}
+
 TEST(SceneCheck, OnePartSceneIsTheSingleMeshCheck) {
   const SmallMesh mesh = folded_grid(11, 7);
   auto scene = make_checker(2), single = make_checker(2);

@@ -22,7 +22,8 @@ void internal_nodes_of_level(const CompleteTree& shape, int32_t level, int32_t& 
 
 void Tree::build(mesh::MeshView mesh, int threads) {
   const int32_t n = mesh.triangle_count;
-  shape_ = CompleteTree(n);
+  // A part without triangles (an obstacle file with none) has an empty tree: no nodes.
+  shape_ = n > 0 ? CompleteTree(n) : CompleteTree();
   boxes_.assign(static_cast<size_t>(shape_.node_count()), geom::empty_box());
   triangle_at_.resize(static_cast<size_t>(n));
   std::iota(triangle_at_.begin(), triangle_at_.end(), 0);

@@ -27,7 +27,10 @@ using detail::quote_token;
 class ObjParser {
  public:
   ObjParser(std::string_view text, const std::string& name, detail::StructureCache* cache)
-      : p_(text.data()), end_(text.data() + text.size()), name_(name), cache_(cache) {}
+      : p_(text.data()), end_(text.data() + text.size()), name_(name), cache_(cache) {
+    // A UTF-8 byte order mark, which some Windows tools write: not part of the first line.
+    if (text.starts_with("\xEF\xBB\xBF")) p_ += 3;
+  }
 
   mesh::Mesh parse() {
     if (cache_ && cache_->valid) {
@@ -160,6 +163,32 @@ class ObjParser {
       p_ = ptr;
     }
     mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
+    skip_blanks();
+    if (!at_eol() && *p_ != '#') check_vertex_extras();
+  }
+
+  /// What may follow a vertex's x y z: w, or a colour's r g b and maybe a, finite numbers that
+  /// are read and not kept; anything else is an error, so that a line that runs on (a file
+  /// whose lines end with a lone CR reads as one line) is not taken as one vertex.
+  void check_vertex_extras() {
+    static const std::string kExpected =
+        "; expected x y z, then nothing, w, or a colour's r g b [a]";
+    int extras = 0;
+    for (; !at_eol() && *p_ != '#'; ++extras) {
+      const char* start = p_;
+      const char* first = detail::past_plus(p_, end_);
+      double value = 0;
+      auto [ptr, ec] = detail::parse_double(first, end_, value);
+      if (extras == 4 || ec != std::errc() || ptr == first || !detail::ends_token(ptr, end_) ||
+          !std::isfinite(value)) {
+        const bool lone_cr = start[-1] == '\r';  // after "v x y z": never the text's start
+        fail("unexpected " + quote_token(start, end_) + " after the vertex's coordinates" +
+             kExpected + (lone_cr ? " (are the file's lines ended by a lone CR?)" : ""));
+      }
+      p_ = ptr;
+      skip_blanks();
+    }
+    if (extras == 2) fail("vertex has 5 numbers" + kExpected);
   }
 
   /// The usual face line, "f A B C" with three positive indices of vertices already listed,

@@ -39,7 +39,7 @@ SNAG_HD_INLINE int count_trailing_zeros(uint32_t x) {
 }
 
 struct CompleteTree {
-  int32_t leaf_count = 0;      ///< n >= 1
+  int32_t leaf_count = 0;      ///< n >= 1, or 0 in the empty tree (CompleteTree())
   int32_t depth = 0;           ///< D, the deepest level
   int32_t deepest_leaves = 0;  ///< m = 2n - 2^D
 
@@ -49,7 +49,8 @@ struct CompleteTree {
         depth(floor_log2(static_cast<uint32_t>(2 * n - 1))),
         deepest_leaves(2 * n - (1 << floor_log2(static_cast<uint32_t>(2 * n - 1)))) {}
 
-  SNAG_HD_INLINE int32_t node_count() const { return 2 * leaf_count - 1; }
+  /// 2n - 1; 0 for the empty tree (a part without triangles).
+  SNAG_HD_INLINE int32_t node_count() const { return leaf_count > 0 ? 2 * leaf_count - 1 : 0; }
   SNAG_HD_INLINE int32_t first_leaf() const { return leaf_count - 1; }
   SNAG_HD_INLINE bool is_leaf(int32_t node) const { return node >= leaf_count - 1; }
   SNAG_HD_INLINE static int32_t level_of(int32_t node) {
