@@ -679,6 +679,13 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         }
 
       if (i == 0 || topology_changed) {
+        // An empty file checks clean, which a gate should not pass in silence (a cache cut
+        // short, a zero-byte export).
+        for (int32_t o = 0; o < object_count; ++o)
+          if (layout.triangle_begin[o + 1] == layout.triangle_begin[o])
+            warn(scene_frame.files[o] + ": no triangles (" +
+                 std::to_string(layout.vertex_begin[o + 1] - layout.vertex_begin[o]) +
+                 " vertices); nothing of it is checked");
         // Welding is decided once per topology, on its first frame, per object with its own
         // tolerance: seams stay closed while the cloth moves, and a weld that changed from
         // frame to frame would rebuild the tree.

@@ -145,6 +145,34 @@ TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
   EXPECT_NE(r.err.find("[3/3] frame 3: clean"), std::string::npos) << r.err;
 }
 
+// A file without triangles checks clean, with a warning that says so: alone, as an obstacle
+// (whose empty tree has no pairs with the cloth) and as a cloth with an obstacle.
+TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {
+  TempDir tmp;
+  write_text(tmp.path() / "empty.obj", "");
+  write_text(tmp.path() / "points.obj", "v 0 0 0\nv 1 0 0\n");
+  // Two triangles crossing each other: one crossing pair.
+  write_text(tmp.path() / "x.obj",
+             "v 0 0 0\nv 2 0 0\nv 0 2 0\nv 0.5 0.2 -1\nv 0.5 0.2 1\nv 0.5 1 0\nf 1 2 3\nf 4 5 6\n");
+  const RunResult alone = run_snag({"check", "empty.obj", "--out", "a"}, tmp.path());
+  EXPECT_EQ(alone.status, 0) << context(alone);
+  EXPECT_NE(alone.err.find("empty.obj: no triangles (0 vertices)"), std::string::npos) << alone.err;
+  EXPECT_EQ(read_text(tmp.path() / "a" / "pairs.csv"), "frame,face_a,face_b,kind,poly_a,poly_b\n");
+
+  const RunResult obstacle =
+      run_snag({"check", "x.obj", "--obstacle", "points.obj", "--out", "b"}, tmp.path());
+  EXPECT_EQ(obstacle.status, 1) << context(obstacle);
+  EXPECT_NE(obstacle.err.find("points.obj: no triangles (2 vertices)"), std::string::npos)
+      << obstacle.err;
+  EXPECT_EQ(read_text(tmp.path() / "b" / "pairs.csv"),
+            "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n"
+            "0,0,1,crossing,0,1,cloth,cloth\n");
+
+  const RunResult cloth = run_snag({"check", "empty.obj", "--obstacle", "x.obj", "-q"}, tmp.path());
+  EXPECT_EQ(cloth.status, 0) << context(cloth);
+  EXPECT_EQ(cloth.err, "") << "--quiet: no warning";
+}
+
 TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
   // Two flat triangles side by side along their hypotenuse, each with its own copy of the seam's
   // two vertices (an unwelded seam): as separate vertices they touch along the seam; welded,
