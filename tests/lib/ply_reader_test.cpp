@@ -361,6 +361,43 @@ TEST(PlyReader, RejectsTruncatedAscii) {
   expect_contains(e, "file ends inside face 1 (of 2)");
 }
 
+// One record per line: a short or long line is an error at that line, not values borrowed
+// from the next line.
+TEST(PlyReader, AsciiRecordsAreOnePerLine) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  // Lines 10 to 13: the vertices, then the face.
+  {
+    const InputError e = reject(head + "0 0 0\n1 0\n0 1 0 0\n3 0 1 2\n");
+    EXPECT_EQ(e.line(), 11);
+    expect_contains(e, "line ends inside vertex 1 (of 3)");
+  }
+  {
+    const InputError e = reject(head + "0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(e.line(), 11);
+    expect_contains(e, "the line of vertex 1 (of 3) goes on");
+    expect_contains(e, "'7'");
+  }
+  {
+    const InputError e = reject(head + "0 0 0 1 0 0\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(e.line(), 10);
+    expect_contains(e, "vertex 0 (of 3)");
+  }
+  {
+    const InputError e = reject(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n");
+    EXPECT_EQ(e.line(), 13);
+    expect_contains(e, "line ends inside face 0 (of 1)");
+  }
+  {
+    const InputError e = reject(head + "0 0 0\n1 0 0\n0 1 0\n");
+    expect_contains(e, "file ends before face 0 (of 1)");
+  }
+  // Blank lines between records, blanks at their ends and no final line end are fine.
+  const mesh::Mesh m = read_ply(head + "\n0 0 0 \n\n1 0 0\t\n0 1 0\n \n3 0 1 2", "t.ply");
+  EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
+}
+
 TEST(PlyReader, RejectsNegativeListCounts) {
   for (Enc enc : {Enc::ascii, Enc::le, Enc::be}) {
     SCOPED_TRACE(format_name(enc));

@@ -604,8 +604,10 @@ class BinaryBody {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Ascii body: blank-separated tokens; records usually sit one per line, but only the token
-// order matters. Lines are counted for error messages.
+// Ascii body: one record per line (blank lines between records passed over), its values
+// blank-separated. A line with fewer or more values than its record's properties is an error
+// at that line: read as one stream of tokens, a short line borrowed the next line's values and
+// the error, if any, surfaced records later. Lines are counted for error messages.
 
 class AsciiBody {
  public:
@@ -633,6 +635,7 @@ class AsciiBody {
       }
       if (is_vertex) mesh_.positions.reserve(static_cast<size_t>(el.count));
       for (int64_t i = 0; i < el.count; ++i) {
+        begin_record(el, i);
         if (is_vertex) {
           read_vertex(el, i);
         } else if (is_face) {
@@ -643,6 +646,7 @@ class AsciiBody {
             for (int64_t k = 0; k < n; ++k) next_token(el, i);
           }
         }
+        end_record(el, i);
       }
       if (is_face) mesh_.polygon_count = el.count;
       if (is_vertex && reuse_.after_vertices(plan_, e, p_, end_, mesh_)) return std::move(mesh_);
@@ -654,14 +658,34 @@ class AsciiBody {
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
 
-  /// Moves to the start of the next token, counting line ends on the way; fails at the end of
-  /// the file.
-  const char* skip_to_token(const Element& el, int64_t i) {
+  /// Moves to the line of record i: past the line end after the record before and any blank
+  /// lines, counting them; fails at the end of the file.
+  void begin_record(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank_or_eol(*p_)) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
-    if (p_ == end_) fail("file ends inside " + record_name(el, i) + "; expected more values");
+    if (p_ == end_) fail("file ends before " + record_name(el, i) + "; expected more records");
+  }
+
+  /// Past the blanks after record i's last value; fails unless its line ends there.
+  void end_record(const Element& el, int64_t i) {
+    while (p_ < end_ && is_blank(*p_)) ++p_;
+    if (p_ < end_ && *p_ != '\n') {
+      fail("the line of " + record_name(el, i) + " goes on after its " +
+           std::to_string(el.properties.size()) + " propert" +
+           (el.properties.size() == 1 ? "y" : "ies") + "' values with " + quote_token(p_, end_) +
+           "; expected one record per line");
+    }
+  }
+
+  /// Moves to the start of the record's next value on its line; fails at the line's end.
+  const char* skip_to_token(const Element& el, int64_t i) {
+    while (p_ < end_ && is_blank(*p_)) ++p_;
+    if (p_ == end_ || *p_ == '\n') {
+      fail(std::string(p_ == end_ ? "file" : "line") + " ends inside " + record_name(el, i) +
+           "; expected more values (one record per line)");
+    }
     return p_;
   }
 
