@@ -5,6 +5,7 @@
 //   2 usage error, 3 input or output error, 4 internal error or no usable CUDA device when one
 //   was asked for.
 #include <malloc.h>
+#include <signal.h>
 #include <CLI/CLI.hpp>
 
 #include <exception>
@@ -15,7 +16,32 @@
 #include "snag/error.h"
 #include "snag/report/write.h"
 
+namespace {
+
+/// SIGINT, SIGTERM, SIGHUP (Ctrl-C, a render farm's kill, a closed terminal): the report
+/// temporaries go, then the signal does what it would have done, so the status says so.
+extern "C" void on_terminating_signal(int signal_number) {
+  snag::report::remove_temporaries_on_signal();
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+void remove_temporaries_when_killed() {
+  struct sigaction action {};
+  action.sa_handler = on_terminating_signal;
+  sigemptyset(&action.sa_mask);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction was {};
+    // A signal the caller ignores (nohup, a background job's SIGINT) stays ignored.
+    if (::sigaction(signal_number, nullptr, &was) == 0 && was.sa_handler == SIG_IGN) continue;
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  remove_temporaries_when_killed();
   // Every frame allocates and frees the same few large arrays (positions, faces, report text)
   // on reader threads and the checker's. glibc serves blocks above its mmap threshold with a
   // fresh mmap and returns them with munmap, whose TLB shootdown interrupts every core running

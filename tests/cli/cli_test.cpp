@@ -1,10 +1,17 @@
 // The `snag` executable end to end: hand-built sequences with exact expected reports, exit
 // statuses 0 to 3, no report left by a failed run, and --help against the man page.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <regex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -171,6 +178,59 @@ TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {
   const RunResult cloth = run_snag({"check", "empty.obj", "--obstacle", "x.obj", "-q"}, tmp.path());
   EXPECT_EQ(cloth.status, 0) << context(cloth);
   EXPECT_EQ(cloth.err, "") << "--quiet: no warning";
+}
+
+// Ctrl-C or a farm's kill midway: the run ends by that signal, and its output directory holds
+// no report temporary (only finished reports would be there, and there are none yet).
+TEST(CliCheck, KilledRunLeavesNoTemporaries) {
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "seq");
+  // 3,000 frames (the drape sample's 12 over and over), so that the run is still going when
+  // its temporaries have appeared.
+  const fs::path drape = source_dir() / "samples" / "drape";
+  for (int f = 1; f <= 3000; ++f) {
+    char name[32], sample[32];
+    std::snprintf(name, sizeof name, "f.%04d.obj", f);
+    std::snprintf(sample, sizeof sample, "drape.%04d.obj", (f - 1) % 12 + 1);
+    fs::create_symlink(drape / sample, tmp.path() / "seq" / name);
+  }
+  const std::string executable = snag_executable().string();
+  for (int signal_number : {SIGINT, SIGTERM}) {
+    const fs::path out = tmp.path() / ("out" + std::to_string(signal_number));
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
+      ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
+              "--fail-on", "none", "--out", out.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    const auto temporaries = [&] {
+      int count = 0;
+      std::error_code ec;
+      for (const auto& entry : fs::directory_iterator(out, ec))
+        count += entry.path().filename().string().find(".tmp-") != std::string::npos;
+      return count;
+    };
+    bool seen = false;
+    int status = 0;
+    pid_t ended = 0;
+    for (int wait = 0; wait < 30000 && !seen && ended == 0; ++wait) {
+      seen = temporaries() > 0;
+      if (!seen) {
+        ended = ::waitpid(child, &status, WNOHANG);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    }
+    if (ended == 0) {
+      ::kill(child, signal_number);
+      ::waitpid(child, &status, 0);
+    }
+    EXPECT_TRUE(seen) << "the run ended before its temporaries were seen";
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
+        << "signal " << signal_number << ", status " << status;
+    EXPECT_EQ(temporaries(), 0) << "signal " << signal_number;
+  }
 }
 
 TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {

@@ -543,6 +543,30 @@ TEST(ReportStream, ExceptionMidRunLeavesNoFileAndKeepsTheEarlierRun) {
   expect_earlier_run(tmp.path());
 }
 
+// What a SIGINT or SIGTERM handler calls (cli/main.cpp): the temporaries of a stream still
+// writing go, an earlier run's reports and a finished stream's stay, and a stream finished
+// since has nothing left tracked (its reports are not removed by a later call).
+TEST(ReportStream, SignalCleanupRemovesOnlyTemporaries) {
+  TempDir earlier, done;
+  write_earlier_run(earlier.path());
+  {
+    ReportStream stream(earlier.path(), "1.2.3", small_settings());
+    for (const FrameRecord& f : small_frames()) stream.add(f);
+    ReportStream finished(done.path(), "1.2.3", small_settings());
+    for (const FrameRecord& f : small_frames()) finished.add(f);
+    finished.finish(small_inputs(), 1, 0, 2.5);
+    ASSERT_EQ(entries(earlier.path()).size(), 7u);  // three reports and four temporaries
+    snag::report::remove_temporaries_on_signal();
+    expect_earlier_run(earlier.path());
+    EXPECT_EQ(entries(done.path()),
+              (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+  }  // the stream unwinds without finishing, as after an exception: nothing more to remove
+  expect_earlier_run(earlier.path());
+  snag::report::remove_temporaries_on_signal();
+  EXPECT_EQ(entries(done.path()),
+            (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
+}
+
 TEST(ReportStream, SceneObjectsMustMatchAtFinish) {
   TempDir tmp;
   write_earlier_run(tmp.path());

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <system_error>
+#include <utility>
 
 #include "snag/error.h"
 #include "snag/report/write.h"
@@ -13,6 +14,48 @@
 namespace snag::report {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The temporaries on disk, for remove_temporaries_on_signal: fixed slots that a signal handler
+// can read (lock-free atomics and plain bytes; nothing allocated). A slot is tracked before its
+// file is created and released after the file is removed or renamed, so a signal at any point
+// finds every temporary that exists (and perhaps one that does not yet or no longer: its
+// unlink fails harmlessly). A run holds a handful at once; past the slots, a temporary is not
+// tracked and only a signal would leave it behind.
+constexpr int kTrackedSlots = 64;
+enum SlotState : int { kFree = 0, kFilling = 1, kTracked = 2 };
+struct TrackedTemporary {
+  std::atomic<int> state{kFree};
+  char path[4096];
+};
+TrackedTemporary tracked[kTrackedSlots];
+
+/// The slot now holding `path`, or -1 when none is free or the path is too long.
+int track(const fs::path& path) {
+  const std::string& text = path.native();
+  if (text.size() >= sizeof(TrackedTemporary::path)) return -1;
+  for (int i = 0; i < kTrackedSlots; ++i) {
+    int expected = kFree;
+    if (tracked[i].state.compare_exchange_strong(expected, kFilling)) {
+      std::memcpy(tracked[i].path, text.c_str(), text.size() + 1);
+      tracked[i].state.store(kTracked, std::memory_order_release);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void untrack(int slot) {
+  if (slot >= 0) tracked[slot].state.store(kFree, std::memory_order_release);
+}
+
+}  // namespace
+
+void remove_temporaries_on_signal() noexcept {
+  for (TrackedTemporary& t : tracked)
+    if (t.state.load(std::memory_order_acquire) == kTracked) ::unlink(t.path);
+}
 
 fs::path temporary_name(const fs::path& dir, const std::string& name) {
   static std::atomic<unsigned> counter{0};
@@ -60,17 +103,19 @@ StagedFiles::~StagedFiles() {
   for (Entry& e : entries_) {
     e.file.reset();
     remove_quietly(e.temporary_path);
+    untrack(e.tracked_slot);
   }
 }
 
 StagedFile& StagedFiles::open(fs::path temporary_path, const std::string& name, bool scratch) {
   if (committed_) throw InternalError("report: " + name + " created after the commit");
-  entries_.push_back({temporary_path, nullptr, scratch});
+  entries_.push_back({temporary_path, nullptr, scratch, track(temporary_path)});
   try {
     entries_.back().file = std::make_unique<StagedFile>(std::move(temporary_path), dir_ / name);
   } catch (...) {
     // Not created, or created and not writable: either way it is not part of the set.
     remove_quietly(entries_.back().temporary_path);
+    untrack(entries_.back().tracked_slot);
     entries_.pop_back();
     throw;
   }
@@ -90,12 +135,16 @@ void StagedFiles::commit() {
   committed_ = true;
   for (Entry& e : entries_) e.file->close();
   for (Entry& e : entries_)
-    if (e.scratch) remove_quietly(e.temporary_path);
+    if (e.scratch) {
+      remove_quietly(e.temporary_path);
+      untrack(std::exchange(e.tracked_slot, -1));
+    }
   for (Entry& e : entries_) {
     if (e.scratch) continue;
     std::error_code ec;
     fs::rename(e.temporary_path, e.file->final_path(), ec);
     if (ec) throw WriteError(e.file->final_path(), "cannot rename into place: " + ec.message());
+    untrack(std::exchange(e.tracked_slot, -1));
   }
 }
 

@@ -84,6 +84,7 @@ class StagedFiles {
     std::filesystem::path temporary_path;  ///< what the destructor removes
     std::unique_ptr<StagedFile> file;      ///< unique_ptr: references stay valid as the set grows
     bool scratch = false;
+    int tracked_slot = -1;  ///< for remove_temporaries_on_signal, while the file may exist
   };
   StagedFile& open(std::filesystem::path temporary_path, const std::string& name, bool scratch);
 

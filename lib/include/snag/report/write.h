@@ -41,6 +41,12 @@ void write_files_atomically(const std::filesystem::path& dir, const std::vector<
 /// does not fail at its end); creates it. Throws WriteError otherwise.
 void prepare_output_dir(const std::filesystem::path& dir);
 
+/// Removes every report temporary of this process that may be on disk (written, not yet
+/// renamed into place or removed); finished reports are not touched. Async-signal-safe (atomic
+/// loads and unlink): for a handler of SIGINT or SIGTERM, so that a run killed midway leaves no
+/// hidden temporaries in its output directory, as a run that fails leaves none.
+void remove_temporaries_on_signal() noexcept;
+
 /// Writes pairs.csv, frames.csv and report.json into `dir`, all complete or none, through a
 /// ReportStream fed report.frames in increasing frame number (stable: the documented order of
 /// Report::frames; a report recorded out of order gets its report.json frames sorted too,
