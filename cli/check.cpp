@@ -37,6 +37,13 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+/// An option value that may not be empty (`--out ''` would write no report, silently).
+CLI::Validator non_empty(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& value) { return value.empty() ? "expected " + what + ", found ''" : ""; },
+      "", "non-empty");
+}
+
 detect::RebuildPolicy rebuild_policy(const std::string& name) {
   if (name == "never") return detect::RebuildPolicy::never;
   if (name == "always") return detect::RebuildPolicy::always;
@@ -183,9 +190,11 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("NAME");
   cmd->add_option("-o,--out", o.out_dir,
                   "Write pairs.csv, frames.csv and report.json into DIR (created if missing)")
-      ->type_name("DIR");
+      ->type_name("DIR")
+      ->check(non_empty("a directory"));
   cmd->add_option("--frames", o.frames, "Check only these frames: 1-240, 1-240x5, 1-10,20-30")
-      ->type_name("SEL");
+      ->type_name("SEL")
+      ->check(non_empty("a frame selection"));
   cmd->add_option("--weld", o.weld,
                   "Vertices closer than TOL count as one for adjacency (reports keep the "
                   "file's ids)")

@@ -276,6 +276,8 @@ TEST(CliStatus, UsageErrorsExitTwo) {
       {"check", "seq", "--weld", "-0.5"},
       {"check", "seq", "--frames", "abc"},
       {"check", "seq", "--frames", "100-200"},
+      {"check", "seq", "--frames", ""},
+      {"check", "seq", "--out", ""},
       {"bench"},
   };
   for (const auto& args : cases) {

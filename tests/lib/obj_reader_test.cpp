@@ -319,6 +319,16 @@ TEST(ObjReader, RejectsWhatRunsOnAfterAVertex) {
   EXPECT_NE(std::string(e.what()).find("lone CR"), std::string::npos) << e.what();
 }
 
+// A message quotes bytes that are not printable as \xNN: a NUL does not cut it short, an escape
+// sequence does not reach the terminal.
+TEST(ObjReader, MessagesQuoteOddBytesPrintably) {
+  static const char kText[] = "v 0 0 0\nv 1 a\0b\x1b[31m\xff 0\n";
+  const InputError e = reject(std::string(kText, sizeof kText - 1));
+  const std::string what = e.what();
+  EXPECT_NE(what.find("'a\\x00b\\x1b[31m\\xff'"), std::string::npos) << what;
+  for (const char c : what) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << what;
+}
+
 TEST(ObjReader, ByteOrderMarkIsSkipped) {
   const mesh::Mesh m = read_obj("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj");
   ASSERT_EQ(m.positions.size(), 3u);

@@ -398,6 +398,41 @@ TEST(PlyReader, AsciiRecordsAreOnePerLine) {
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
 }
 
+TEST(PlyReader, RejectsOtherVersionsAndPropertiesDeclaredTwice) {
+  const std::string vertex =
+      "element vertex 0\nproperty float x\nproperty float y\nproperty float z\n";
+  expect_contains(reject("ply\nformat ascii 2.0\n" + vertex + "end_header\n"),
+                  "PLY version '2.0'; expected 1.0");
+  expect_contains(reject("ply\nformat binary_little_endian 1\n" + vertex + "end_header\n"),
+                  "PLY version '1'");
+  expect_contains(reject("ply\nformat ascii 1.0\n" + vertex + "property float x\nend_header\n"),
+                  "property 'x' of element 'vertex' is declared twice");
+  // A header line of binary bytes is quoted printably, NUL included.
+  static const char kHeader[] = "ply\nformat ascii 1.0\n\x01\0\xfe\nend_header\n";
+  const InputError e = reject(std::string(kHeader, sizeof kHeader - 1));
+  expect_contains(e, "'\\x01\\x00\\xfe'");
+}
+
+// An integer property's values in an ascii file are those its type holds, as in a binary one.
+TEST(PlyReader, AsciiIntegerCoordinatesAreValuesOfTheirType) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty short x\nproperty uchar y\n"
+      "property int z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const mesh::Mesh m =
+      read_ply(head + "-32768 0 2147483647\n32767 255 -2147483648\n1 2 3\n3 0 1 2\n", "t.ply");
+  EXPECT_EQ(m.positions[0], (Vec3d{-32768, 0, 2147483647}));
+  EXPECT_EQ(m.positions[1], (Vec3d{32767, 255, -2147483648.0}));
+  for (const char* bad :
+       {"0 256 0", "0 -1 0", "0 0.5 0", "32768 0 0", "0 0 2147483648", "0 1e2 0.25"}) {
+    const InputError e = reject(head + "0 0 0\n" + bad + "\n1 2 3\n3 0 1 2\n");
+    EXPECT_EQ(e.line(), 11) << bad;
+    expect_contains(e, "is not a value of its");
+  }
+  expect_contains(reject(head + "0 0 0\n0 256 0\n1 2 3\n3 0 1 2\n"),
+                  "y coordinate '256' of vertex 1 (of 3) is not a value of its uchar property; "
+                  "expected a whole number from 0 to 255");
+}
+
 TEST(PlyReader, RejectsNegativeListCounts) {
   for (Enc enc : {Enc::ascii, Enc::le, Enc::be}) {
     SCOPED_TRACE(format_name(enc));

@@ -49,6 +49,49 @@ bool is_integer(Scalar t) {
   return t != Scalar::f32 && t != Scalar::f64;
 }
 
+/// The name of type `t` in a header.
+const char* scalar_type_name(Scalar t) {
+  switch (t) {
+    case Scalar::i8:
+      return "char";
+    case Scalar::u8:
+      return "uchar";
+    case Scalar::i16:
+      return "short";
+    case Scalar::u16:
+      return "ushort";
+    case Scalar::i32:
+      return "int";
+    case Scalar::u32:
+      return "uint";
+    case Scalar::f32:
+      return "float";
+    case Scalar::f64:
+      return "double";
+  }
+  return "?";
+}
+
+/// The values of integer type `t`, lowest and highest.
+std::pair<double, double> integer_range(Scalar t) {
+  switch (t) {
+    case Scalar::i8:
+      return {-128.0, 127.0};
+    case Scalar::u8:
+      return {0.0, 255.0};
+    case Scalar::i16:
+      return {-32768.0, 32767.0};
+    case Scalar::u16:
+      return {0.0, 65535.0};
+    case Scalar::i32:
+      return {-2147483648.0, 2147483647.0};
+    case Scalar::u32:
+      return {0.0, 4294967295.0};
+    default:
+      return {0.0, 0.0};
+  }
+}
+
 bool parse_scalar_name(std::string_view s, Scalar& out) {
   struct Name {
     std::string_view name;
@@ -120,7 +163,7 @@ void split_words(std::string_view line, std::vector<std::string_view>& words) {
 }
 
 std::string quote(std::string_view s) {
-  return "'" + std::string(s) + "'";
+  return "'" + detail::printable(s) + "'";
 }
 
 Header parse_header(std::string_view bytes, const std::string& name) {
@@ -172,6 +215,8 @@ Header parse_header(std::string_view bytes, const std::string& name) {
         fail("unknown PLY format " + quote(words[1]) +
              "; expected ascii, binary_little_endian or binary_big_endian");
       }
+      // 1.0 is the only version there is; another would be a format this reader cannot know.
+      if (words[2] != "1.0") fail("PLY version " + quote(words[2]) + "; expected 1.0");
       have_format = true;
     } else if (key == "element") {
       if (words.size() != 3) fail("expected 'element <name> <count>', found " + quote(text));
@@ -214,6 +259,11 @@ Header parse_header(std::string_view bytes, const std::string& name) {
         }
         p.name = std::string(words[2]);
       }
+      for (const Property& earlier : h.elements.back().properties)
+        if (earlier.name == p.name) {
+          fail("property " + quote(p.name) + " of element " + quote(h.elements.back().name) +
+               " is declared twice");
+        }
       h.elements.back().properties.push_back(std::move(p));
     } else {
       fail("unknown header line " + quote(text.substr(0, 60)) +
@@ -733,8 +783,12 @@ class AsciiBody {
         continue;
       }
       const char* start = skip_to_token(el, i);
-      // A plain decimal of at most 8 + 8 digits, in range of a float: nothing to check.
-      if (detail::parse_shaped(start, end_, shapes_[axis], xyz[axis], p_)) continue;
+      // A plain decimal of at most 8 + 8 digits, in range of a float: nothing to check but an
+      // integer type's range.
+      if (detail::parse_shaped(start, end_, shapes_[axis], xyz[axis], p_)) {
+        check_integer_value(el, i, prop, axis, start, xyz[axis]);
+        continue;
+      }
       // The number is parsed straight from the text and must end its token, so that each
       // character is read once.
       const char* first = detail::past_plus(start, end_);
@@ -754,9 +808,24 @@ class AsciiBody {
         fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
              record_name(el, i) + " does not fit its float property; expected a finite float");
       }
+      check_integer_value(el, i, prop, axis, start, xyz[axis]);
       p_ = ptr;
     }
     mesh_.positions.push_back({xyz[0], xyz[1], xyz[2]});
+  }
+
+  /// A coordinate of an integer property (`property uchar z`) must be a value of that type, as
+  /// a binary file's would be: a whole number in the type's range.
+  void check_integer_value(const Element& el, int64_t i, const Property& prop, int axis,
+                           const char* start, double value) const {
+    if (!is_integer(prop.type)) return;
+    const auto [low, high] = integer_range(prop.type);
+    if (value != std::floor(value) || value < low || value > high) {
+      fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+           record_name(el, i) + " is not a value of its " + scalar_type_name(prop.type) +
+           " property; expected a whole number from " + std::to_string(static_cast<int64_t>(low)) +
+           " to " + std::to_string(static_cast<int64_t>(high)));
+    }
   }
 
   void read_face(const Element& el, int64_t i) {

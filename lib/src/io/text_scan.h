@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 #if defined(__SSE2__)
@@ -229,6 +230,26 @@ inline const char* parse_shaped_index(const char* first, const char* end, uint8_
 #endif
 }
 
+/// `text` with every byte that is not printable ASCII (a control byte, DEL, 0x80 and above)
+/// written as \xNN, so that a message quoting a file's bytes is neither cut short at a NUL nor
+/// sends a terminal escape sequences.
+inline std::string printable(std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out += c;
+    } else {
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 15];
+    }
+  }
+  return out;
+}
+
 /// The whitespace-delimited token starting at `p`, quoted, shortened past 40 characters so that
 /// a binary file read as text does not flood the message.
 inline std::string quote_token(const char* p, const char* end) {
@@ -238,7 +259,7 @@ inline std::string quote_token(const char* p, const char* end) {
   std::string s;
   s.reserve(static_cast<size_t>(q - p) + 5);
   s += '\'';
-  s.append(p, q);
+  s += printable(std::string_view(p, static_cast<size_t>(q - p)));
   if (q < end && !is_blank_or_eol(*q)) s += "...";
   s += '\'';
   return s;
