@@ -168,7 +168,10 @@ void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& da
                       " when present (default: $SNAG_DATA_DIR, else the one known at build time)")
       ->type_name("DIR");
   cmd->add_option("--input", *o.inputs, "Also " + verb + " this sequence (repeatable)")
-      ->type_name("SEQUENCE");
+      ->type_name("SEQUENCE")
+      ->expected(1)
+      ->take_all()
+      ->allow_extra_args(false);
   cmd->add_option("--generator", *o.generator,
                   "The snag-cloth sample generator (default: beside snag, in the build tree, or "
                   "on PATH)")

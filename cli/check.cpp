@@ -177,7 +177,10 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
   cmd->add_option("--obstacle", o.obstacles,
                   "A body or prop SEQUENCE checked against the cloth (one file: still); "
                   "repeatable. Its own self-intersections are not checked")
-      ->type_name("SEQUENCE");
+      ->type_name("SEQUENCE")
+      ->expected(1)  // one value a flag, repeated: `--obstacle body.obj dress.%04d.obj` works
+      ->take_all()
+      ->allow_extra_args(false);
   cmd->add_option("--scene", o.scene,
                   "A scene file (JSON): objects, their roles, checks, weld and ignore rules")
       ->type_name("FILE");
@@ -187,7 +190,10 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
   cmd->add_option("--obstacle-group", o.obstacle_groups,
                   "With --split-groups: this group is an obstacle (not checked against itself "
                   "or other obstacles); repeatable")
-      ->type_name("NAME");
+      ->type_name("NAME")
+      ->expected(1)
+      ->take_all()
+      ->allow_extra_args(false);
   cmd->add_option("-o,--out", o.out_dir,
                   "Write pairs.csv, frames.csv and report.json into DIR (created if missing)")
       ->type_name("DIR")

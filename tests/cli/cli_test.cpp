@@ -175,6 +175,14 @@ TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {
             "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n"
             "0,0,1,crossing,0,1,cloth,cloth\n");
 
+  // --obstacle takes one value: the cloth's SEQUENCE may follow it.
+  const RunResult before = run_snag(
+      {"check", "--obstacle", "points.obj", "--obstacle", "empty.obj", "x.obj", "-q"}, tmp.path());
+  EXPECT_EQ(before.status, 1) << context(before);
+  EXPECT_NE(before.out.find("objects              cloth (cloth), points (obstacle"),
+            std::string::npos)
+      << before.out;
+
   const RunResult cloth = run_snag({"check", "empty.obj", "--obstacle", "x.obj", "-q"}, tmp.path());
   EXPECT_EQ(cloth.status, 0) << context(cloth);
   EXPECT_EQ(cloth.err, "") << "--quiet: no warning";
@@ -206,17 +214,18 @@ TEST(CliCheck, KilledRunLeavesNoTemporaries) {
       ::_exit(127);
     }
     const auto temporaries = [&] {
-      int count = 0;
+      std::string names;
       std::error_code ec;
       for (const auto& entry : fs::directory_iterator(out, ec))
-        count += entry.path().filename().string().find(".tmp-") != std::string::npos;
-      return count;
+        if (entry.path().filename().string().find(".tmp-") != std::string::npos)
+          names += entry.path().filename().string() + " ";
+      return names;
     };
     bool seen = false;
     int status = 0;
     pid_t ended = 0;
     for (int wait = 0; wait < 30000 && !seen && ended == 0; ++wait) {
-      seen = temporaries() > 0;
+      seen = !temporaries().empty();
       if (!seen) {
         ended = ::waitpid(child, &status, WNOHANG);
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -229,7 +238,7 @@ TEST(CliCheck, KilledRunLeavesNoTemporaries) {
     EXPECT_TRUE(seen) << "the run ended before its temporaries were seen";
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
         << "signal " << signal_number << ", status " << status;
-    EXPECT_EQ(temporaries(), 0) << "signal " << signal_number;
+    EXPECT_EQ(temporaries(), "") << "signal " << signal_number;
   }
 }
 

@@ -3,6 +3,8 @@
 // the summary accumulator against a brute-force recount.
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -543,26 +545,29 @@ TEST(ReportStream, ExceptionMidRunLeavesNoFileAndKeepsTheEarlierRun) {
   expect_earlier_run(tmp.path());
 }
 
-// What a SIGINT or SIGTERM handler calls (cli/main.cpp): the temporaries of a stream still
-// writing go, an earlier run's reports and a finished stream's stay, and a stream finished
-// since has nothing left tracked (its reports are not removed by a later call).
+// What a SIGINT or SIGTERM handler calls (cli/main.cpp), in a child process as in a handler
+// (it leaves the process removing every temporary made after it): the temporaries of a stream
+// still writing go, an earlier run's reports and a finished stream's stay.
 TEST(ReportStream, SignalCleanupRemovesOnlyTemporaries) {
   TempDir earlier, done;
   write_earlier_run(earlier.path());
-  {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
     ReportStream stream(earlier.path(), "1.2.3", small_settings());
     for (const FrameRecord& f : small_frames()) stream.add(f);
     ReportStream finished(done.path(), "1.2.3", small_settings());
     for (const FrameRecord& f : small_frames()) finished.add(f);
     finished.finish(small_inputs(), 1, 0, 2.5);
-    ASSERT_EQ(entries(earlier.path()).size(), 7u);  // three reports and four temporaries
+    // Three reports and four temporaries: exit status 2 if not, to tell it from the checks'.
+    if (entries(earlier.path()).size() != 7u) ::_exit(2);
     snag::report::remove_temporaries_on_signal();
-    expect_earlier_run(earlier.path());
-    EXPECT_EQ(entries(done.path()),
-              (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
-  }  // the stream unwinds without finishing, as after an exception: nothing more to remove
+    ::_exit(0);  // as the signal would: no destructor runs
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
   expect_earlier_run(earlier.path());
-  snag::report::remove_temporaries_on_signal();
   EXPECT_EQ(entries(done.path()),
             (std::vector<std::string>{"frames.csv", "pairs.csv", "report.json"}));
 }

@@ -30,6 +30,12 @@ struct TrackedTemporary {
   char path[4096];
 };
 TrackedTemporary tracked[kTrackedSlots];
+// Set by remove_temporaries_on_signal before it looks at the slots. Another thread may be
+// creating a temporary meanwhile: if the handler's look missed its slot, or unlinked the path
+// before the file existed, the creator sees this set once its file exists (all seq_cst: the
+// handler's store precedes its loads, the creator's slot store precedes its load of this)
+// and removes the file itself.
+std::atomic<bool> terminating{false};
 
 /// The slot now holding `path`, or -1 when none is free or the path is too long.
 int track(const fs::path& path) {
@@ -39,7 +45,7 @@ int track(const fs::path& path) {
     int expected = kFree;
     if (tracked[i].state.compare_exchange_strong(expected, kFilling)) {
       std::memcpy(tracked[i].path, text.c_str(), text.size() + 1);
-      tracked[i].state.store(kTracked, std::memory_order_release);
+      tracked[i].state.store(kTracked);
       return i;
     }
   }
@@ -53,8 +59,9 @@ void untrack(int slot) {
 }  // namespace
 
 void remove_temporaries_on_signal() noexcept {
+  terminating.store(true);
   for (TrackedTemporary& t : tracked)
-    if (t.state.load(std::memory_order_acquire) == kTracked) ::unlink(t.path);
+    if (t.state.load() == kTracked) ::unlink(t.path);
 }
 
 fs::path temporary_name(const fs::path& dir, const std::string& name) {
@@ -112,6 +119,7 @@ StagedFile& StagedFiles::open(fs::path temporary_path, const std::string& name, 
   entries_.push_back({temporary_path, nullptr, scratch, track(temporary_path)});
   try {
     entries_.back().file = std::make_unique<StagedFile>(std::move(temporary_path), dir_ / name);
+    if (terminating.load()) remove_quietly(entries_.back().temporary_path);  // see `terminating`
   } catch (...) {
     // Not created, or created and not writable: either way it is not part of the set.
     remove_quietly(entries_.back().temporary_path);

@@ -139,7 +139,7 @@ FrameRecord make_frame_record(int64_t frame, std::string file, const detect::Fra
 struct Settings {
   std::string backend;            ///< backend that ran ("cpu")
   std::string backend_requested;  ///< as asked on the command line ("auto", "cpu")
-  int threads = 0;                ///< worker threads used
+  int threads = 0;                ///< the run's threads (--threads resolved), readers included
   std::string exact;              ///< the --exact mode: "off", "uncertain" or "all"
   /// Who decides the tests the filter leaves: "cgal" (exact predicates) or "rounded" (the
   /// signs of the rounded doubles, mode off).

@@ -44,7 +44,8 @@ void prepare_output_dir(const std::filesystem::path& dir);
 /// Removes every report temporary of this process that may be on disk (written, not yet
 /// renamed into place or removed); finished reports are not touched. Async-signal-safe (atomic
 /// loads and unlink): for a handler of SIGINT or SIGTERM, so that a run killed midway leaves no
-/// hidden temporaries in its output directory, as a run that fails leaves none.
+/// hidden temporaries in its output directory, as a run that fails leaves none. For a process
+/// that is ending: a temporary another thread creates after the call is removed at once.
 void remove_temporaries_on_signal() noexcept;
 
 /// Writes pairs.csv, frames.csv and report.json into `dir`, all complete or none, through a
