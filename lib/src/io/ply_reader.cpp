@@ -710,33 +710,47 @@ class AsciiBody {
 
   /// Moves to the line of record i: past the line end after the record before and any blank
   /// lines, counting them; fails at the end of the file.
+  // The checks below are inlined into the loops over records and values; their messages are
+  // built out of line (a third of the ascii parse went to calls while they were together).
   void begin_record(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank_or_eol(*p_)) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
-    if (p_ == end_) fail("file ends before " + record_name(el, i) + "; expected more records");
+    if (p_ == end_) [[unlikely]]
+      fail_before_record(el, i);
   }
 
   /// Past the blanks after record i's last value; fails unless its line ends there.
   void end_record(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank(*p_)) ++p_;
-    if (p_ < end_ && *p_ != '\n') {
-      fail("the line of " + record_name(el, i) + " goes on after its " +
-           std::to_string(el.properties.size()) + " propert" +
-           (el.properties.size() == 1 ? "y" : "ies") + "' values with " + quote_token(p_, end_) +
-           "; expected one record per line");
-    }
+    if (p_ < end_ && *p_ != '\n') [[unlikely]]
+      fail_after_record(el, i);
   }
 
   /// Moves to the start of the record's next value on its line; fails at the line's end.
   const char* skip_to_token(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank(*p_)) ++p_;
-    if (p_ == end_ || *p_ == '\n') {
-      fail(std::string(p_ == end_ ? "file" : "line") + " ends inside " + record_name(el, i) +
-           "; expected more values (one record per line)");
-    }
+    if (p_ == end_ || *p_ == '\n') [[unlikely]]
+      fail_inside_record(el, i);
     return p_;
+  }
+
+  [[noreturn, gnu::cold, gnu::noinline]] void fail_before_record(const Element& el,
+                                                                 int64_t i) const {
+    fail("file ends before " + record_name(el, i) + "; expected more records");
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void fail_after_record(const Element& el,
+                                                                int64_t i) const {
+    fail("the line of " + record_name(el, i) + " goes on after its " +
+         std::to_string(el.properties.size()) + " propert" +
+         (el.properties.size() == 1 ? "y" : "ies") + "' values with " + quote_token(p_, end_) +
+         "; expected one record per line");
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void fail_inside_record(const Element& el,
+                                                                 int64_t i) const {
+    fail(std::string(p_ == end_ ? "file" : "line") + " ends inside " + record_name(el, i) +
+         "; expected more values (one record per line)");
   }
 
   /// Moves past the next token; returns its start.
@@ -746,8 +760,19 @@ class AsciiBody {
     return start;
   }
 
-  int64_t next_integer(const Element& el, int64_t i, const Property& prop, const char* what) {
+  /// The record's next value as an integer; with `length`, its column's usual length, read as
+  /// parse_shaped_index reads OBJ's corners.
+  int64_t next_integer(const Element& el, int64_t i, const Property& prop, const char* what,
+                       uint8_t* length = nullptr) {
     const char* start = skip_to_token(el, i);
+    if (length) {
+      uint64_t shaped = 0;
+      const char* after = detail::parse_shaped_index(start, end_, *length, shaped);
+      if (after && detail::ends_token(after, end_)) {
+        p_ = after;
+        return static_cast<int64_t>(shaped);
+      }
+    }
     int64_t v = 0;
     auto [ptr, ec] = detail::parse_integer(start, end_, v);
     if (ec != std::errc() || !detail::ends_token(ptr, end_)) {
@@ -820,12 +845,17 @@ class AsciiBody {
                            const char* start, double value) const {
     if (!is_integer(prop.type)) return;
     const auto [low, high] = integer_range(prop.type);
-    if (value != std::floor(value) || value < low || value > high) {
-      fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
-           record_name(el, i) + " is not a value of its " + scalar_type_name(prop.type) +
-           " property; expected a whole number from " + std::to_string(static_cast<int64_t>(low)) +
-           " to " + std::to_string(static_cast<int64_t>(high)));
-    }
+    if (value != std::floor(value) || value < low || value > high) [[unlikely]]
+      fail_integer_value(el, i, prop, axis, start, low, high);
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void fail_integer_value(const Element& el, int64_t i,
+                                                                 const Property& prop, int axis,
+                                                                 const char* start, double low,
+                                                                 double high) const {
+    fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
+         record_name(el, i) + " is not a value of its " + scalar_type_name(prop.type) +
+         " property; expected a whole number from " + std::to_string(static_cast<int64_t>(low)) +
+         " to " + std::to_string(static_cast<int64_t>(high)));
   }
 
   void read_face(const Element& el, int64_t i) {
@@ -837,13 +867,14 @@ class AsciiBody {
         for (int64_t c = 0; c < n; ++c) next_token(el, i);
         continue;
       }
-      const int64_t n = next_integer(el, i, prop, "corner count");
+      const int64_t n = next_integer(el, i, prop, "corner count", &count_length_);
       if (n < 3) {
         fail(record_name(el, i) + " has " + std::to_string(n) + " corners; expected at least 3");
       }
       corners_.clear();
       for (int64_t c = 0; c < n; ++c) {
-        const int64_t v = next_integer(el, i, prop, "vertex index");
+        const int64_t v = next_integer(el, i, prop, "vertex index",
+                                       c < kShapedCorners ? &corner_lengths_[c] : nullptr);
         if (v < 0 || v >= vertex_count) {
           fail("corner " + std::to_string(c) + " of " + record_name(el, i) + " is vertex " +
                std::to_string(v) + "; expected 0.." + std::to_string(vertex_count - 1) + " (" +
@@ -865,6 +896,10 @@ class AsciiBody {
   std::vector<int32_t> corners_;
   StructureReuse reuse_;
   detail::DecimalShape shapes_[3];  // the x, y and z columns' last layouts (parse_shaped)
+  // The faces' columns' last lengths (parse_shaped_index): the corner count, the first corners.
+  static constexpr int64_t kShapedCorners = 8;
+  uint8_t count_length_ = 0;
+  uint8_t corner_lengths_[kShapedCorners] = {};
 };
 
 mesh::Mesh parse_ply(std::string_view bytes, const std::string& name_for_errors,
