@@ -396,6 +396,19 @@ TEST(PlyReader, AsciiRecordsAreOnePerLine) {
   // Blank lines between records, blanks at their ends and no final line end are fine.
   const mesh::Mesh m = read_ply(head + "\n0 0 0 \n\n1 0 0\t\n0 1 0\n \n3 0 1 2", "t.ply");
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
+  // An element without properties takes no line; one of one property names it so.
+  const std::string vertices =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n";
+  EXPECT_EQ(
+      tris(read_ply(vertices + "element empty 2\n" + faces + "end_header\n" + body + "3 0 1 2\n",
+                    "t.ply")),
+      (Tris{{0, 1, 2}}));
+  expect_contains(reject(vertices + "element flag 1\nproperty uchar f\n" + faces + "end_header\n" +
+                         body + "1 2\n3 0 1 2\n"),
+                  "the line of flag 0 (of 1) goes on after its 1 property's values with '2'");
 }
 
 TEST(PlyReader, RejectsOtherVersionsAndPropertiesDeclaredTwice) {

@@ -684,7 +684,9 @@ class AsciiBody {
                              " records, more than the rest of the file can hold");
       }
       if (is_vertex) mesh_.positions.reserve(static_cast<size_t>(el.count));
-      for (int64_t i = 0; i < el.count; ++i) {
+      // An element without properties has records of no values, which take no line.
+      const bool has_values = !el.properties.empty();
+      for (int64_t i = 0; i < el.count && has_values; ++i) {
         begin_record(el, i);
         if (is_vertex) {
           read_vertex(el, i);
@@ -743,9 +745,9 @@ class AsciiBody {
   [[noreturn, gnu::cold, gnu::noinline]] void fail_after_record(const Element& el,
                                                                 int64_t i) const {
     fail("the line of " + record_name(el, i) + " goes on after its " +
-         std::to_string(el.properties.size()) + " propert" +
-         (el.properties.size() == 1 ? "y" : "ies") + "' values with " + quote_token(p_, end_) +
-         "; expected one record per line");
+         std::to_string(el.properties.size()) +
+         (el.properties.size() == 1 ? " property's" : " properties'") + " values with " +
+         quote_token(p_, end_) + "; expected one record per line");
   }
   [[noreturn, gnu::cold, gnu::noinline]] void fail_inside_record(const Element& el,
                                                                  int64_t i) const {

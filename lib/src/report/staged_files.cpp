@@ -1,5 +1,6 @@
 #include "staged_files.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -18,50 +19,72 @@ namespace fs = std::filesystem;
 namespace {
 
 // The temporaries on disk, for remove_temporaries_on_signal: fixed slots that a signal handler
-// can read (lock-free atomics and plain bytes; nothing allocated). A slot is tracked before its
-// file is created and released after the file is removed or renamed, so a signal at any point
-// finds every temporary that exists (and perhaps one that does not yet or no longer: its
-// unlink fails harmlessly). A run holds a handful at once; past the slots, a temporary is not
-// tracked and only a signal would leave it behind.
+// can read (lock-free atomics and plain bytes; nothing allocated). A slot is taken before its
+// file is created (kCreating, with the creating thread's id) and marked kTracked once the file
+// exists; it is released after the file is removed or renamed. The handler waits a moment for
+// other threads' slots that are still being taken or created, so that the file it then unlinks
+// exists, and copies a path out before unlinking it, checking that the slot was not released
+// and taken again meanwhile (its generation). A run holds a handful at once; past the slots, a
+// temporary is not tracked and only a signal would leave it behind. What can still escape: a
+// temporary whose slot is taken after the handler has looked at it, in the microseconds before
+// the process ends.
 constexpr int kTrackedSlots = 64;
-enum SlotState : int { kFree = 0, kFilling = 1, kTracked = 2 };
+enum SlotState : int { kFree = 0, kCreating = 1, kTracked = 2 };
 struct TrackedTemporary {
   std::atomic<int> state{kFree};
+  std::atomic<uint32_t> generation{0};  ///< counts the slot's takings
+  std::atomic<pid_t> creator{0};        ///< the thread creating its file (kCreating)
   char path[4096];
 };
 TrackedTemporary tracked[kTrackedSlots];
-// Set by remove_temporaries_on_signal before it looks at the slots. Another thread may be
-// creating a temporary meanwhile: if the handler's look missed its slot, or unlinked the path
-// before the file existed, the creator sees this set once its file exists (all seq_cst: the
-// handler's store precedes its loads, the creator's slot store precedes its load of this)
-// and removes the file itself.
+// Set by remove_temporaries_on_signal before it looks at the slots: a temporary created after
+// its look is removed by its creator, when the process lives long enough for that.
 std::atomic<bool> terminating{false};
 
-/// The slot now holding `path`, or -1 when none is free or the path is too long.
+/// The slot now holding `path`, in state kCreating, or -1 when none is free or the path is too
+/// long. mark_created() once the file exists.
 int track(const fs::path& path) {
   const std::string& text = path.native();
   if (text.size() >= sizeof(TrackedTemporary::path)) return -1;
   for (int i = 0; i < kTrackedSlots; ++i) {
     int expected = kFree;
-    if (tracked[i].state.compare_exchange_strong(expected, kFilling)) {
+    if (tracked[i].state.compare_exchange_strong(expected, kCreating)) {
+      tracked[i].generation.fetch_add(1);
+      tracked[i].creator.store(::gettid());
       std::memcpy(tracked[i].path, text.c_str(), text.size() + 1);
-      tracked[i].state.store(kTracked);
       return i;
     }
   }
   return -1;
 }
 
+void mark_created(int slot) {
+  if (slot >= 0) tracked[slot].state.store(kTracked);
+}
+
 void untrack(int slot) {
-  if (slot >= 0) tracked[slot].state.store(kFree, std::memory_order_release);
+  if (slot >= 0) tracked[slot].state.store(kFree);
 }
 
 }  // namespace
 
 void remove_temporaries_on_signal() noexcept {
   terminating.store(true);
-  for (TrackedTemporary& t : tracked)
-    if (t.state.load() == kTracked) ::unlink(t.path);
+  const pid_t self = ::gettid();
+  for (TrackedTemporary& t : tracked) {
+    // Another thread taking this slot or creating its file: up to ~20 ms for it to finish.
+    for (int wait = 0; wait < 200 && t.state.load() == kCreating && t.creator.load() != self;
+         ++wait) {
+      const timespec pause{0, 100000};
+      ::nanosleep(&pause, nullptr);
+    }
+    const uint32_t generation = t.generation.load();
+    if (t.state.load() == kFree) continue;
+    char path[sizeof t.path];
+    std::memcpy(path, t.path, sizeof path);
+    path[sizeof path - 1] = '\0';
+    if (t.generation.load() == generation && t.state.load() != kFree) ::unlink(path);
+  }
 }
 
 fs::path temporary_name(const fs::path& dir, const std::string& name) {
@@ -119,6 +142,7 @@ StagedFile& StagedFiles::open(fs::path temporary_path, const std::string& name, 
   entries_.push_back({temporary_path, nullptr, scratch, track(temporary_path)});
   try {
     entries_.back().file = std::make_unique<StagedFile>(std::move(temporary_path), dir_ / name);
+    mark_created(entries_.back().tracked_slot);
     if (terminating.load()) remove_quietly(entries_.back().temporary_path);  // see `terminating`
   } catch (...) {
     // Not created, or created and not writable: either way it is not part of the set.
