@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -265,6 +266,44 @@ void put_as(Body& b, int kind, double v) {
     default:
       b.put<double>(v);
       break;
+  }
+}
+
+// Float coordinates among other properties (the records' fixed-size path with offsets): random
+// values come back as written, and the first non-finite one is the one named, in every
+// encoding.
+TEST_P(PlyEncodings, FloatCoordinatesAmongOtherPropertiesAndTheFirstBadOne) {
+  const Enc enc = GetParam();
+  const int count = 300;
+  const std::string h = header(enc, "element vertex " + std::to_string(count) +
+                                        "\nproperty uchar red\nproperty float y\nproperty short s\n"
+                                        "property float x\nproperty float z\n"
+                                        "element face 0\nproperty list uchar int vertex_indices\n");
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> value(-1e6f, 1e6f);
+  std::vector<Vec3d> written;
+  Body good(enc);
+  for (int i = 0; i < count; ++i) {
+    const float x = value(rng), y = value(rng), z = value(rng);
+    good.put<uint8_t>(9).put<float>(y).put<int16_t>(-3).put<float>(x).put<float>(z).end();
+    written.push_back({x, y, z});
+  }
+  EXPECT_EQ(read_ply(h + good.str(), "t.ply").positions, written);
+  for (const int bad_vertex : {0, 137, count - 1}) {
+    Body b(enc);
+    for (int i = 0; i < count; ++i) {
+      const float z = i == bad_vertex ? std::numeric_limits<float>::infinity() : 1.0f;
+      // A NaN in x of a later vertex too: the first bad value is the one named.
+      const float x = i == bad_vertex + 1 ? std::numeric_limits<float>::quiet_NaN() : 2.0f;
+      b.put<uint8_t>(9).put<float>(3.0f).put<int16_t>(-3).put<float>(x).put<float>(z).end();
+    }
+    const InputError e = reject(h + b.str());
+    expect_contains(e, "z coordinate");
+    expect_contains(e, "of vertex " + std::to_string(bad_vertex) + " (of 300)");
+    if (enc != Enc::ascii) {
+      EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(h.size()) + bad_vertex * 15 + 11);
+      expect_contains(e, "infinite");
+    }
   }
 }
 

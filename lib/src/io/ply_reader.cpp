@@ -497,6 +497,10 @@ class BinaryBody {
         offsets[axis] = off;
         types[axis] = el.properties[plan_.xyz[axis]].type;
       }
+      if (types[0] == Scalar::f32 && types[1] == Scalar::f32 && types[2] == Scalar::f32) {
+        read_float_vertices(el, offsets, min_bytes);
+        return;
+      }
       for (int64_t i = 0; i < el.count; ++i, p_ += min_bytes) {
         double xyz[3];
         for (int axis = 0; axis < 3; ++axis) {
@@ -527,6 +531,33 @@ class BinaryBody {
       }
       mesh_.positions[i] = {xyz[0], xyz[1], xyz[2]};
     }
+  }
+
+  /// read_vertices' fixed-size records when x, y and z are all floats (what most writers
+  /// write): no type dispatch per value, and one test of the records' exponent bits for
+  /// finiteness (a float is NaN or infinite when its exponent bits are all ones), the record at
+  /// fault found again only when one is not. A third of a binary frame's time in sequence went
+  /// to the dispatching loop.
+  void read_float_vertices(const Element& el, const int offsets[3], int64_t stride) {
+    constexpr uint32_t kExponent = 0x7f800000u;
+    geom::Vec3d* const out = mesh_.positions.data();
+    const char* const first = p_;
+    uint32_t all_ones_somewhere = 0;
+    for (int64_t i = 0; i < el.count; ++i, p_ += stride) {
+      const uint32_t x = load32(p_ + offsets[0]), y = load32(p_ + offsets[1]),
+                     z = load32(p_ + offsets[2]);
+      all_ones_somewhere |= static_cast<uint32_t>((x & kExponent) == kExponent) |
+                            static_cast<uint32_t>((y & kExponent) == kExponent) |
+                            static_cast<uint32_t>((z & kExponent) == kExponent);
+      out[i] = {std::bit_cast<float>(x), std::bit_cast<float>(y), std::bit_cast<float>(z)};
+    }
+    if (!all_ones_somewhere) return;
+    for (int64_t i = 0; i < el.count; ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        const char* at = first + i * stride + offsets[axis];
+        const double v = std::bit_cast<float>(load32(at));
+        if (!std::isfinite(v)) bad_coordinate(el, i, axis, v, at);
+      }
   }
 
   [[noreturn]] void bad_coordinate(const Element& el, int64_t i, int axis, double v,
