@@ -133,9 +133,9 @@ inline uint64_t eight_digits_value(uint64_t chunk, int count) {
 /// but is a plain decimal of up to 8 + 8 digits that fits in the 16 bytes, `shape` becomes its
 /// layout and it is read the same way. Returns false, with nothing changed but `shape`, for any
 /// other token or when fewer than 18 bytes are left (the loads reach 17 bytes past a sign);
-/// then parse_double decides. On true, `value`
-/// is parse_double's value bit for bit (the same mantissa divided by the same power of ten)
-/// and `after` the token's end, which is followed by a blank or a line end.
+/// then parse_double decides. On true, `value` is parse_double's value bit for bit (the same
+/// mantissa divided by the same power of ten) and `after` the token's end, which is followed
+/// by a blank or a line end.
 inline bool parse_shaped(const char* first, const char* end, DecimalShape& shape, double& value,
                          const char*& after) {
 #if defined(__SSE2__)
