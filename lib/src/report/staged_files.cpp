@@ -87,6 +87,14 @@ void remove_temporaries_on_signal() noexcept {
   }
 }
 
+SignalTracked::SignalTracked(const fs::path& temporary_path) : slot_(track(temporary_path)) {}
+SignalTracked::~SignalTracked() {
+  untrack(slot_);
+}
+void SignalTracked::created() {
+  mark_created(slot_);
+}
+
 fs::path temporary_name(const fs::path& dir, const std::string& name) {
   static std::atomic<unsigned> counter{0};
   return dir / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +

@@ -28,6 +28,21 @@ void remove_quietly(const std::filesystem::path& path);
 /// directory or cannot be created.
 void ensure_directory(const std::filesystem::path& dir);
 
+/// Makes a temporary that is not part of a StagedFiles set (prepare_output_dir's probe) known
+/// to remove_temporaries_on_signal while it lives: construct it before creating the file, call
+/// created() once the file exists, and remove the file before it is destroyed.
+class SignalTracked {
+ public:
+  explicit SignalTracked(const std::filesystem::path& temporary_path);
+  ~SignalTracked();
+  SignalTracked(const SignalTracked&) = delete;
+  SignalTracked& operator=(const SignalTracked&) = delete;
+  void created();
+
+ private:
+  int slot_;
+};
+
 /// One temporary file being written.
 class StagedFile {
  public:

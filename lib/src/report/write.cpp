@@ -16,11 +16,15 @@ namespace fs = std::filesystem;
 void prepare_output_dir(const fs::path& dir) {
   ensure_directory(dir);
   const fs::path probe = temporary_name(dir, "probe");
+  SignalTracked tracked(probe);  // a signal meanwhile removes it too
   std::ofstream out(probe, std::ios::binary);
   const int err = errno;
-  if (!out)
+  if (!out) {
+    remove_quietly(probe);
     throw WriteError(dir,
                      std::string("cannot write into the output directory: ") + std::strerror(err));
+  }
+  tracked.created();
   out.close();
   remove_quietly(probe);
 }
