@@ -49,29 +49,6 @@ bool is_integer(Scalar t) {
   return t != Scalar::f32 && t != Scalar::f64;
 }
 
-/// The name of type `t` in a header.
-const char* scalar_type_name(Scalar t) {
-  switch (t) {
-    case Scalar::i8:
-      return "char";
-    case Scalar::u8:
-      return "uchar";
-    case Scalar::i16:
-      return "short";
-    case Scalar::u16:
-      return "ushort";
-    case Scalar::i32:
-      return "int";
-    case Scalar::u32:
-      return "uint";
-    case Scalar::f32:
-      return "float";
-    case Scalar::f64:
-      return "double";
-  }
-  return "?";
-}
-
 /// The values of integer type `t`, lowest and highest.
 std::pair<double, double> integer_range(Scalar t) {
   switch (t) {
@@ -92,26 +69,35 @@ std::pair<double, double> integer_range(Scalar t) {
   }
 }
 
+/// The header's type names, each type's usual name first.
+struct ScalarName {
+  std::string_view name;
+  Scalar type;
+};
+constexpr ScalarName kScalarNames[] = {
+    {"char", Scalar::i8},     {"int8", Scalar::i8},     {"uchar", Scalar::u8},
+    {"uint8", Scalar::u8},    {"short", Scalar::i16},   {"int16", Scalar::i16},
+    {"ushort", Scalar::u16},  {"uint16", Scalar::u16},  {"int", Scalar::i32},
+    {"int32", Scalar::i32},   {"uint", Scalar::u32},    {"uint32", Scalar::u32},
+    {"float", Scalar::f32},   {"float32", Scalar::f32}, {"double", Scalar::f64},
+    {"float64", Scalar::f64},
+};
+
 bool parse_scalar_name(std::string_view s, Scalar& out) {
-  struct Name {
-    std::string_view name;
-    Scalar type;
-  };
-  static constexpr Name names[] = {
-      {"char", Scalar::i8},     {"int8", Scalar::i8},     {"uchar", Scalar::u8},
-      {"uint8", Scalar::u8},    {"short", Scalar::i16},   {"int16", Scalar::i16},
-      {"ushort", Scalar::u16},  {"uint16", Scalar::u16},  {"int", Scalar::i32},
-      {"int32", Scalar::i32},   {"uint", Scalar::u32},    {"uint32", Scalar::u32},
-      {"float", Scalar::f32},   {"float32", Scalar::f32}, {"double", Scalar::f64},
-      {"float64", Scalar::f64},
-  };
-  for (const Name& n : names) {
+  for (const ScalarName& n : kScalarNames) {
     if (n.name == s) {
       out = n.type;
       return true;
     }
   }
   return false;
+}
+
+/// The usual name of type `t` in a header (for messages).
+std::string_view scalar_type_name(Scalar t) {
+  for (const ScalarName& n : kScalarNames)
+    if (n.type == t) return n.name;
+  return "?";
 }
 
 struct Property {
@@ -741,10 +727,11 @@ class AsciiBody {
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_, line_, what); }
 
-  /// Moves to the line of record i: past the line end after the record before and any blank
-  /// lines, counting them; fails at the end of the file.
   // The checks below are inlined into the loops over records and values; their messages are
   // built out of line (a third of the ascii parse went to calls while they were together).
+
+  /// Moves to the line of record i: past the line end after the record before and any blank
+  /// lines, counting them; fails at the end of the file.
   void begin_record(const Element& el, int64_t i) {
     while (p_ < end_ && is_blank_or_eol(*p_)) {
       if (*p_ == '\n') ++line_;
@@ -886,7 +873,7 @@ class AsciiBody {
                                                                  const char* start, double low,
                                                                  double high) const {
     fail(std::string(1, "xyz"[axis]) + " coordinate " + quote_token(start, end_) + " of " +
-         record_name(el, i) + " is not a value of its " + scalar_type_name(prop.type) +
+         record_name(el, i) + " is not a value of its " + std::string(scalar_type_name(prop.type)) +
          " property; expected a whole number from " + std::to_string(static_cast<int64_t>(low)) +
          " to " + std::to_string(static_cast<int64_t>(high)));
   }
