@@ -406,28 +406,19 @@ TEST(PlyReader, AsciiRecordsAreOnePerLine) {
   const std::string head =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto expect_rejected_at = [&](const std::string& body, int64_t line,
+                                      const std::string& what) {
+    SCOPED_TRACE(body);
+    const InputError e = reject(head + body);
+    EXPECT_EQ(e.line(), line);
+    expect_contains(e, what);
+  };
   // Lines 10 to 13: the vertices, then the face.
-  {
-    const InputError e = reject(head + "0 0 0\n1 0\n0 1 0 0\n3 0 1 2\n");
-    EXPECT_EQ(e.line(), 11);
-    expect_contains(e, "line ends inside vertex 1 (of 3)");
-  }
-  {
-    const InputError e = reject(head + "0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n");
-    EXPECT_EQ(e.line(), 11);
-    expect_contains(e, "the line of vertex 1 (of 3) goes on");
-    expect_contains(e, "'7'");
-  }
-  {
-    const InputError e = reject(head + "0 0 0 1 0 0\n0 1 0\n3 0 1 2\n");
-    EXPECT_EQ(e.line(), 10);
-    expect_contains(e, "vertex 0 (of 3)");
-  }
-  {
-    const InputError e = reject(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n");
-    EXPECT_EQ(e.line(), 13);
-    expect_contains(e, "line ends inside face 0 (of 1)");
-  }
+  expect_rejected_at("0 0 0\n1 0\n0 1 0 0\n3 0 1 2\n", 11, "line ends inside vertex 1 (of 3)");
+  expect_rejected_at("0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n", 11,
+                     "the line of vertex 1 (of 3) goes on after its 3 properties' values with '7'");
+  expect_rejected_at("0 0 0 1 0 0\n0 1 0\n3 0 1 2\n", 10, "vertex 0 (of 3)");
+  expect_rejected_at("0 0 0\n1 0 0\n0 1 0\n3 0 1\n2\n", 13, "line ends inside face 0 (of 1)");
   {
     const InputError e = reject(head + "0 0 0\n1 0 0\n0 1 0\n");
     expect_contains(e, "file ends before face 0 (of 1)");
