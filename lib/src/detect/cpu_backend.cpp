@@ -347,7 +347,7 @@ class CpuBackend final : public Backend {
     frame.traverse_seconds = seconds_since(start);
 
     const auto classify_start = Clock::now();
-    frame.pairs = expand_hits(topo, hits, degenerate_flags);
+    frame.pairs = expand_hits(topo, hits, degenerate_flags, threads_);
     std::sort(duplicates.begin(), duplicates.end(), [](const FacePair& x, const FacePair& y) {
       return x.a != y.a ? x.a < y.a : x.b < y.b;
     });

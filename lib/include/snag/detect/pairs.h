@@ -14,9 +14,10 @@
 namespace snag::detect {
 
 /// Every (face of the edge, triangle) pair of each hit, leaving out degenerate faces and the
-/// triangle itself, as sorted unique pairs (a < b) of kind `touching` until classified.
+/// triangle itself, as sorted unique pairs (a < b) of kind `touching` until classified. Up to
+/// `threads` OpenMP threads share the work on large lists; the result is the same for any count.
 std::vector<FacePair> expand_hits(const Topology& topology, std::span<const EdgeTriangleTask> hits,
-                                  std::span<const uint8_t> degenerate_flags);
+                                  std::span<const uint8_t> degenerate_flags, int threads = 1);
 
 /// Merges two sorted unique pair lists (kinds of `a` win on equal pairs), keeping a flag list
 /// aligned with the result.

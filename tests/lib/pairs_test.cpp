@@ -1,0 +1,86 @@
+// expand_hits against a brute-force set of its pairs, at several thread counts, on random
+// meshes with non-manifold edges and degenerate faces, large enough that every thread gets a
+// share of the listing and of each radix pass.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "snag/detect/pairs.h"
+#include "snag/detect/topology.h"
+
+namespace snag::detect {
+namespace {
+
+/// `count` proper triangles over `vertices` vertices: a strip of quads (every inner edge shared
+/// by two faces), then random triangles, some of which reuse strip edges (three or more faces).
+std::vector<geom::Tri> strip_and_soup(int32_t vertices, int32_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int32_t> vertex(0, vertices - 1);
+  std::vector<geom::Tri> triangles;
+  for (int32_t v = 0; v + 3 < vertices && static_cast<int32_t>(triangles.size()) < count / 2;
+       v += 2) {
+    triangles.push_back({{v, v + 1, v + 2}});
+    triangles.push_back({{v + 1, v + 3, v + 2}});
+  }
+  while (static_cast<int32_t>(triangles.size()) < count) {
+    const int32_t a = vertex(rng);
+    geom::Tri t{{a, a + 1 < vertices ? a + 1 : a - 1, vertex(rng)}};
+    if (t.v[2] == t.v[0] || t.v[2] == t.v[1]) continue;
+    triangles.push_back(t);
+  }
+  return triangles;
+}
+
+TEST(ExpandHits, MatchesBruteForceAtEveryThreadCount) {
+  for (const int32_t count : {50, 5000, 60000}) {
+    const int32_t vertices = count / 2 + 3;
+    const std::vector<geom::Tri> triangles = strip_and_soup(vertices, count, 7u + count);
+    const Topology topo = make_topology(triangles, vertices);
+    ASSERT_FALSE(topo.edges.empty());
+    std::mt19937 rng(11u + count);
+    std::vector<uint8_t> degenerate(triangles.size(), 0);
+    for (size_t t = 0; t < degenerate.size(); t += 13) degenerate[t] = 1;
+    std::uniform_int_distribution<int32_t> edge(0, static_cast<int32_t>(topo.edges.size()) - 1);
+    std::uniform_int_distribution<int32_t> triangle(0, count - 1);
+    // Hits with repeats (the same pair from several hits) and with the edge's own faces.
+    std::vector<EdgeTriangleTask> hits;
+    for (int32_t i = 0; i < 3 * count; ++i) {
+      const int32_t e = edge(rng);
+      const int32_t own = topo.edge_faces[topo.edge_face_offsets[e]];
+      hits.push_back({e, i % 5 == 0 ? own : triangle(rng)});
+      if (i % 7 == 0) hits.push_back(hits.back());
+    }
+    std::set<std::pair<int32_t, int32_t>> expected;
+    for (const EdgeTriangleTask& hit : hits)
+      for (int32_t i = topo.edge_face_offsets[hit.edge]; i < topo.edge_face_offsets[hit.edge + 1];
+           ++i) {
+        const int32_t face = topo.edge_faces[i];
+        if (face != hit.triangle && !degenerate[face])
+          expected.insert({std::min(face, hit.triangle), std::max(face, hit.triangle)});
+      }
+    for (const int threads : {1, 2, 3, 8}) {
+      SCOPED_TRACE(testing::Message() << count << " triangles, " << threads << " threads");
+      const std::vector<FacePair> pairs = expand_hits(topo, hits, degenerate, threads);
+      ASSERT_EQ(pairs.size(), expected.size());
+      auto want = expected.begin();
+      for (const FacePair& pair : pairs) {
+        EXPECT_EQ(std::make_pair(pair.a, pair.b), *want++);
+        EXPECT_EQ(pair.kind, PairKind::touching);
+      }
+    }
+  }
+}
+
+TEST(ExpandHits, NoHitsNoPairs) {
+  const std::vector<geom::Tri> triangles = {{{0, 1, 2}}, {{1, 3, 2}}};
+  const Topology topo = make_topology(triangles, 4);
+  const std::vector<uint8_t> degenerate(2, 0);
+  EXPECT_TRUE(expand_hits(topo, {}, degenerate, 4).empty());
+}
+
+}  // namespace
+}  // namespace snag::detect
