@@ -116,6 +116,33 @@ TEST_P(PlyEncodings, SquareWithFan) {
   EXPECT_FALSE(m.ids_from_assimp);
 }
 
+// Triangles, a polygon among them, and triangles again: a binary body's run of triangle records
+// is read apart from the rest (read_triangle_records), which must hand over at the polygon with
+// the records' ids and groups as the general loop gives them; and a uint index list.
+TEST_P(PlyEncodings, TrianglesAroundAPolygonKeepTheirRecordIds) {
+  const Enc enc = GetParam();
+  for (const char* index_type : {"int", "uint"}) {
+    SCOPED_TRACE(index_type);
+    Body b(enc);
+    for (int i = 0; i < 5; ++i) b.put<float>(1.f * i).put<float>(i % 2).put<float>(0.f).end();
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).end();
+    b.put<uint8_t>(3).put<int32_t>(1).put<int32_t>(2).put<int32_t>(3).end();
+    b.put<uint8_t>(4).put<int32_t>(0).put<int32_t>(2).put<int32_t>(3).put<int32_t>(4).end();
+    b.put<uint8_t>(3).put<int32_t>(2).put<int32_t>(3).put<int32_t>(4).end();
+    const mesh::Mesh m =
+        read_ply(header(enc,
+                        "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 4\nproperty list uchar " +
+                            std::string(index_type) + " vertex_indices\n") +
+                     b.str(),
+                 "run.ply");
+    EXPECT_EQ(tris(m), (Tris{{0, 1, 2}, {1, 2, 3}, {0, 2, 3}, {0, 3, 4}, {2, 3, 4}}));
+    EXPECT_EQ(m.source_polygon, (std::vector<int32_t>{0, 1, 2, 2, 3}));
+    EXPECT_EQ(m.triangle_group, (std::vector<int32_t>(5, -1)));
+    EXPECT_EQ(m.polygon_count, 4);
+  }
+}
+
 TEST_P(PlyEncodings, SkipsOtherPropertiesAndElements) {
   const Enc enc = GetParam();
   Body b(enc);
@@ -384,6 +411,21 @@ TEST(PlyReader, RejectsTruncatedBinary) {
     expect_contains(e, "face 1 (of 2)");
     expect_contains(e, "expected 12 more bytes, found 10");
     EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(body + 48 + 17 + 1));
+  }
+  // Inside a run of triangle records (read_triangle_records stops short of the cut one).
+  {
+    Body b(Enc::le);
+    for (int i = 0; i < 3; ++i) b.put<float>(1.f * i).put<float>(i % 2).put<float>(0.f);
+    for (int f = 0; f < 3; ++f) b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2);
+    const std::string h =
+        header(Enc::le,
+               "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 3\nproperty list uchar int vertex_indices\n");
+    const std::string whole = h + b.str();
+    const InputError e = reject(whole.substr(0, whole.size() - 5));
+    expect_contains(e, "face 2 (of 3)");
+    expect_contains(e, "expected 12 more bytes, found 7");
+    EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(h.size() + 36 + 2 * 13 + 1));
   }
   // Right after the header.
   expect_contains(reject(full.substr(0, body)), "truncated");
