@@ -154,6 +154,7 @@ std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTria
 
 void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags,
                  std::span<const FacePair> more, std::span<const uint8_t> more_flags) {
+  if (more.empty()) return;  // most frames: nothing to merge, no copy of a long list
   std::vector<FacePair> merged;
   std::vector<uint8_t> flags;
   merged.reserve(into.size() + more.size());
