@@ -2,6 +2,7 @@
 // meshes with non-manifold edges and degenerate faces, large enough that every thread gets a
 // share of the listing and of each radix pass.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <random>
@@ -62,16 +63,32 @@ TEST(ExpandHits, MatchesBruteForceAtEveryThreadCount) {
         if (face != hit.triangle && !degenerate[face])
           expected.insert({std::min(face, hit.triangle), std::max(face, hit.triangle)});
       }
-    for (const int threads : {1, 2, 3, 8}) {
-      SCOPED_TRACE(testing::Message() << count << " triangles, " << threads << " threads");
-      const std::vector<FacePair> pairs = expand_hits(topo, hits, degenerate, threads);
+    auto expect_expected = [&](const std::vector<FacePair>& pairs) {
       ASSERT_EQ(pairs.size(), expected.size());
       auto want = expected.begin();
       for (const FacePair& pair : pairs) {
         EXPECT_EQ(std::make_pair(pair.a, pair.b), *want++);
         EXPECT_EQ(pair.kind, PairKind::touching);
       }
+    };
+    // 0: OpenMP's default count, as everywhere else.
+    for (const int threads : {1, 2, 3, 8, 0}) {
+      SCOPED_TRACE(testing::Message() << count << " triangles, " << threads << " threads");
+      expect_expected(expand_hits(topo, hits, degenerate, threads));
     }
+    // Inside a parallel region with no nesting allowed, the runtime gives a team of one where
+    // expand_hits asks for eight: that one thread must take every run.
+    SCOPED_TRACE(testing::Message() << count << " triangles, nested");
+    const int levels = omp_get_max_active_levels();
+    omp_set_max_active_levels(1);
+    std::vector<FacePair> nested;
+#pragma omp parallel num_threads(2)
+    {
+#pragma omp single
+      nested = expand_hits(topo, hits, degenerate, 8);
+    }
+    omp_set_max_active_levels(levels);
+    expect_expected(nested);
   }
 }
 

@@ -1,96 +1,126 @@
 #include "snag/detect/pairs.h"
 
 #include <algorithm>
+#include <memory>
 
 #include <omp.h>
 
 #include "snag/detect/pair_test.h"
 #include "snag/geom/narrow_phase.h"
+#include "snag/threads.h"
 
 namespace snag::detect {
 
 namespace {
 
-/// Sorts and deduplicates keys below 2^bits with a least-significant-digit radix sort: linear
-/// in the count, where a comparison sort of a frame's hundreds of thousands of hit pairs was a
-/// third of the frame. The fewest passes of digits of at most 12 bits (4,096 counts, 32 KB: in
-/// L1 with room to spare), the bits spread evenly over them: cloth-ball's 34-bit keys take three
-/// passes of 12 bits where 11-bit digits took four (expand_hits on its frames 3.1-3.2 -> 2.5-2.8
-/// ms on the 2-core EPYC), 36K's 32-bit keys three of 11 as before.
-///
-/// Each pass is shared among `threads`: each counts the digits of its own run of keys, and
-/// puts them after the same digit's keys of the runs before its own, so that every pass is
-/// stable and the result is the same for every thread count.
-void sort_unique(std::vector<uint64_t>& keys, int bits, int threads) {
-  constexpr int kMaxDigit = 12;
-  const int passes = (bits + kMaxDigit - 1) / kMaxDigit;
-  const int digit = (bits + passes - 1) / passes;
-  const size_t buckets = size_t{1} << digit;
-  const auto count = static_cast<int64_t>(keys.size());
-  // Below this many keys per thread, one thread does it all (a pass's counts outweigh them).
-  constexpr int64_t kKeysPerThread = 16384;
-  const int team = static_cast<int>(std::clamp<int64_t>(count / kKeysPerThread, 1, threads));
+/// How the least-significant-digit radix sorts below split keys of `bits` bits: the fewest
+/// passes of digits of at most 12 bits (4,096 counts, 32 KB: in L1 with room to spare), the bits
+/// spread evenly over them. Cloth-ball's 34-bit keys take three passes of 12 bits where 11-bit
+/// digits took four (expand_hits on its frames 3.1-3.2 -> 2.5-2.8 ms on the 2-core EPYC), 36K's
+/// 32-bit keys three of 11 as before.
+struct RadixDigits {
+  static constexpr int kMaxDigit = 12;
+  int passes, digit;
+  uint64_t mask;
+  explicit RadixDigits(int bits)
+      : passes((bits + kMaxDigit - 1) / kMaxDigit),
+        digit((bits + passes - 1) / passes),
+        mask((uint64_t{1} << digit) - 1) {}
+  size_t buckets() const { return static_cast<size_t>(mask) + 1; }
+};
+
+/// Sorts and deduplicates keys below 2^bits with a radix sort (RadixDigits), on one thread:
+/// linear in the count, where a comparison sort of a frame's hundreds of thousands of hit pairs
+/// was a third of the frame.
+void sort_unique(std::vector<uint64_t>& keys, int bits) {
+  const RadixDigits radix(bits);
   std::vector<uint64_t> scratch(keys.size());
-  if (team == 1) {  // without a parallel region: at a small frame's few keys, it cost ~15 us
-    std::vector<size_t> start(buckets + 1);
-    for (int shift = 0; shift < bits; shift += digit) {
-      std::fill(start.begin(), start.end(), 0);
-      for (uint64_t k : keys) ++start[((k >> shift) & (buckets - 1)) + 1];
-      for (size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
-      for (uint64_t k : keys) scratch[start[(k >> shift) & (buckets - 1)]++] = k;
-      keys.swap(scratch);
-    }
-    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-    return;
+  std::vector<size_t> start(radix.buckets() + 1);
+  for (int shift = 0; shift < bits; shift += radix.digit) {
+    std::fill(start.begin(), start.end(), 0);
+    for (uint64_t k : keys) ++start[((k >> shift) & radix.mask) + 1];
+    for (size_t b = 0; b < radix.buckets(); ++b) start[b + 1] += start[b];
+    for (uint64_t k : keys) scratch[start[(k >> shift) & radix.mask]++] = k;
+    keys.swap(scratch);
   }
-  // start[t * buckets + b]: where run t's first key of digit b goes.
-  std::vector<int64_t> start(static_cast<size_t>(team) * buckets);
-  // The runtime may give fewer threads than asked for (OMP_THREAD_LIMIT, nesting): the runs
-  // are those of the team it gives.
-#pragma omp parallel num_threads(team)
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+/// The pairs of `count` sorted unique keys a << id_bits | b, of kind `touching`.
+std::vector<FacePair> pairs_of(const uint64_t* keys, size_t count, int id_bits) {
+  std::vector<FacePair> pairs(count);
+  const uint64_t low = (uint64_t{1} << id_bits) - 1;
+  for (size_t i = 0; i < count; ++i)
+    pairs[i] = {static_cast<int32_t>(keys[i] >> id_bits), static_cast<int32_t>(keys[i] & low),
+                PairKind::touching};
+  return pairs;
+}
+
+/// sort_unique of the keys of `runs` joined in order, shared among as many threads as there are
+/// runs, then pairs_of. Each pass is cut into as many pieces (the runs themselves in the first
+/// pass, so that they are never joined; equal slices after): each piece's digits are counted,
+/// then placed after the same digit's keys of the pieces before it, so that every pass is stable
+/// and the result is the same for any number of runs. A piece is any thread's, so a team smaller
+/// than asked for (OMP_THREAD_LIMIT, nesting) still takes every one.
+std::vector<FacePair> sorted_pairs_of_runs(const std::vector<std::vector<uint64_t>>& runs,
+                                           int id_bits) {
+  const int bits = 2 * id_bits;
+  const RadixDigits radix(bits);
+  const size_t buckets = radix.buckets();
+  const int pieces = static_cast<int>(runs.size());
+  int64_t total = 0;
+  for (const std::vector<uint64_t>& run : runs) total += static_cast<int64_t>(run.size());
+  // The passes go from one buffer to the other; each is written whole before it is read, so
+  // neither is zeroed first.
+  std::unique_ptr<uint64_t[]> buffer[2] = {std::make_unique_for_overwrite<uint64_t[]>(total),
+                                           std::make_unique_for_overwrite<uint64_t[]>(total)};
+  std::vector<int64_t> start(static_cast<size_t>(pieces) * buckets);  // [piece][digit]
+#pragma omp parallel num_threads(pieces)
   {
-    const int t = omp_get_thread_num(), runs = omp_get_num_threads();
-    const int64_t first = count * t / runs, last = count * (t + 1) / runs;
-    int64_t* mine = start.data() + static_cast<size_t>(t) * buckets;
-    for (int shift = 0; shift < bits; shift += digit) {
-      std::fill(mine, mine + buckets, 0);
-      for (int64_t i = first; i < last; ++i) ++mine[(keys[i] >> shift) & (buckets - 1)];
+    const int t = omp_get_thread_num(), team = omp_get_num_threads();
+    for (int pass = 0; pass < radix.passes; ++pass) {
+      const int shift = pass * radix.digit;
+      const uint64_t* const from = pass == 0 ? nullptr : buffer[(pass - 1) & 1].get();
+      uint64_t* const to = buffer[pass & 1].get();
+      // Piece q's keys: run q in the first pass, else the q-th slice of the last pass's output.
+      auto piece = [&](int q) {
+        if (pass == 0) return std::span<const uint64_t>(runs[static_cast<size_t>(q)]);
+        const int64_t first = total * q / pieces, last = total * (q + 1) / pieces;
+        return std::span<const uint64_t>(from + first, static_cast<size_t>(last - first));
+      };
+      for (int q = t; q < pieces; q += team) {
+        int64_t* const counts = start.data() + static_cast<size_t>(q) * buckets;
+        std::fill(counts, counts + buckets, 0);
+        for (const uint64_t k : piece(q)) ++counts[(k >> shift) & radix.mask];
+      }
 #pragma omp barrier
 #pragma omp single
       {
         int64_t at = 0;
         for (size_t b = 0; b < buckets; ++b)
-          for (int r = 0; r < runs; ++r) {
-            int64_t& slot = start[static_cast<size_t>(r) * buckets + b];
-            const int64_t run_count = slot;
+          for (int q = 0; q < pieces; ++q) {
+            int64_t& slot = start[static_cast<size_t>(q) * buckets + b];
+            const int64_t count = slot;
             slot = at;
-            at += run_count;
+            at += count;
           }
-      }  // the single's closing barrier: every run's starts are set
-      for (int64_t i = first; i < last; ++i)
-        scratch[mine[(keys[i] >> shift) & (buckets - 1)]++] = keys[i];
+      }  // the single's closing barrier: every piece's starts are set
+      for (int q = t; q < pieces; q += team) {
+        int64_t* const next = start.data() + static_cast<size_t>(q) * buckets;
+        for (const uint64_t k : piece(q)) to[next[(k >> shift) & radix.mask]++] = k;
+      }
 #pragma omp barrier
-#pragma omp single
-      keys.swap(scratch);
     }
   }
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  uint64_t* const sorted = buffer[(radix.passes - 1) & 1].get();
+  const auto count = static_cast<size_t>(std::unique(sorted, sorted + total) - sorted);
+  return pairs_of(sorted, count, id_bits);
 }
 
 int bits_for(int64_t count) {
   int bits = 1;
   while ((int64_t{1} << bits) < count) ++bits;
   return bits;
-}
-
-/// The pairs of sorted unique keys a << id_bits | b, of kind `touching`.
-std::vector<FacePair> pairs_of(const std::vector<uint64_t>& keys, int id_bits) {
-  std::vector<FacePair> pairs(keys.size());
-  const uint64_t low = (uint64_t{1} << id_bits) - 1;
-  for (size_t i = 0; i < keys.size(); ++i)
-    pairs[i] = {static_cast<int32_t>(keys[i] >> id_bits), static_cast<int32_t>(keys[i] & low),
-                PairKind::touching};
-  return pairs;
 }
 
 }  // namespace
@@ -100,18 +130,10 @@ std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTria
   // Pairs packed as a << id_bits | b, so that sorting the keys sorts by (a, b).
   const int id_bits = bits_for(topo.triangle_count());
   const auto hit_count = static_cast<int64_t>(hits.size());
-  constexpr int64_t kHitsPerThread = 8192;
-  const int team = static_cast<int>(std::clamp<int64_t>(hit_count / kHitsPerThread, 1, threads));
   // The keys of hits [first, last), appended to `out`.
   auto list_keys = [&](int64_t first, int64_t last, std::vector<uint64_t>& out) {
     out.reserve(out.size() + static_cast<size_t>(last - first) * 2);
     for (int64_t h = first; h < last; ++h) {
-      // A hit's edge is anywhere in the edge lists: its faces waited on two cache misses, one
-      // after the other. Ahead of time, the offsets of the hit 16 on, then the faces of the hit
-      // 8 on (its offsets by then in cache).
-      if (h + 16 < last) __builtin_prefetch(&topo.edge_face_offsets[hits[h + 16].edge]);
-      if (h + 8 < last)
-        __builtin_prefetch(&topo.edge_faces[topo.edge_face_offsets[hits[h + 8].edge]]);
       const EdgeTriangleTask& hit = hits[h];
       for (int32_t i = topo.edge_face_offsets[hit.edge]; i < topo.edge_face_offsets[hit.edge + 1];
            ++i) {
@@ -123,33 +145,22 @@ std::vector<FacePair> expand_hits(const Topology& topo, std::span<const EdgeTria
       }
     }
   };
-  std::vector<uint64_t> keys;
-  if (team == 1) {
+  // A run of hits per thread, of at least kHitsPerThread: below that, one thread without a
+  // parallel region (which cost ~15 us a frame at 2,244 triangles).
+  constexpr int64_t kHitsPerThread = 8192;
+  const int runs =
+      static_cast<int>(std::clamp<int64_t>(hit_count / kHitsPerThread, 1, thread_count(threads)));
+  if (runs == 1) {
+    std::vector<uint64_t> keys;
     list_keys(0, hit_count, keys);
-    sort_unique(keys, 2 * id_bits, threads);
-    return pairs_of(keys, id_bits);
+    sort_unique(keys, 2 * id_bits);
+    return pairs_of(keys.data(), keys.size(), id_bits);
   }
-  // Each thread lists the keys of its own run of hits; the lists are then joined in run order.
-  // (Runs of the team the runtime gives, as in sort_unique.)
-  std::vector<std::vector<uint64_t>> run_keys(static_cast<size_t>(team));
-#pragma omp parallel num_threads(team)
-  {
-    const int t = omp_get_thread_num(), runs = omp_get_num_threads();
-    std::vector<uint64_t>& out = run_keys[static_cast<size_t>(t)];
-    list_keys(hit_count * t / runs, hit_count * (t + 1) / runs, out);
-#pragma omp barrier
-#pragma omp single
-    {
-      size_t total = 0;
-      for (int r = 0; r < runs; ++r) total += run_keys[static_cast<size_t>(r)].size();
-      keys.resize(total);
-    }
-    size_t at = 0;
-    for (int r = 0; r < t; ++r) at += run_keys[static_cast<size_t>(r)].size();
-    std::copy(out.begin(), out.end(), keys.begin() + static_cast<std::ptrdiff_t>(at));
-  }
-  sort_unique(keys, 2 * id_bits, threads);
-  return pairs_of(keys, id_bits);
+  std::vector<std::vector<uint64_t>> run_keys(static_cast<size_t>(runs));
+#pragma omp parallel num_threads(runs)
+  for (int r = omp_get_thread_num(); r < runs; r += omp_get_num_threads())
+    list_keys(hit_count * r / runs, hit_count * (r + 1) / runs, run_keys[static_cast<size_t>(r)]);
+  return sorted_pairs_of_runs(run_keys, id_bits);
 }
 
 void merge_pairs(std::vector<FacePair>& into, std::vector<uint8_t>& into_flags,
