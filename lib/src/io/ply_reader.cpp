@@ -583,10 +583,12 @@ class BinaryBody {
     const Property& list = el.properties[plan_.indices];
     const int count_size = scalar_size(list.count_type);
     const int index_size = scalar_size(list.type);
-    const int64_t first = el.properties.size() == 1 && count_size == 1 && index_size == 4
-                              ? read_triangle_records(el, vertex_count)
-                              : 0;
-    for (int64_t i = first; i < el.count; ++i) {
+    // The usual record (the list alone, a one-byte count, four-byte indices) is read apart while
+    // the records are triangles (read_triangle_records): from the first record, and again after
+    // each record this loop takes.
+    const bool usual = el.properties.size() == 1 && count_size == 1 && index_size == 4;
+    for (int64_t i = usual ? read_triangle_records(el, 0, vertex_count) : 0; i < el.count;
+         i = usual ? read_triangle_records(el, i + 1, vertex_count) : i + 1) {
       for (size_t k = 0; k < el.properties.size(); ++k) {
         const Property& prop = el.properties[k];
         if (static_cast<int>(k) != plan_.indices) {
@@ -633,16 +635,17 @@ class BinaryBody {
     mesh_.polygon_count = el.count;
   }
 
-  /// read_faces' first records while each is a triangle whose record is the index list alone,
-  /// its count one byte and its indices four (what most writers write: `property list uchar int
-  /// vertex_indices`): 13 bytes a record, read without a type dispatch and written in place,
-  /// where the general loop's dispatch and three push_backs a face were most of a binary
-  /// frame's parse. Returns the first record it did not take (a polygon, a corner out of range,
-  /// a record past the end of the file, or el.count): the general loop goes on from there and
-  /// reports what is wrong with it.
-  int64_t read_triangle_records(const Element& el, int64_t vertex_count) {
+  /// read_faces' records from `first` on while each is a triangle whose record is the index
+  /// list alone, its count one byte and its indices four (what most writers write: `property
+  /// list uchar int vertex_indices`): 13 bytes a record, read without a type dispatch and
+  /// written in place, where the general loop's dispatch and three push_backs a face were most
+  /// of a binary frame's parse. Returns the first record it did not take (a polygon, a corner
+  /// out of range, a record past the end of the file, or el.count): the general loop takes that
+  /// one and reports what is wrong with it.
+  int64_t read_triangle_records(const Element& el, int64_t first, int64_t vertex_count) {
     constexpr int64_t kRecordBytes = 13;
-    const int64_t available = std::min<int64_t>(el.count, (end_ - p_) / kRecordBytes);
+    const int64_t available = std::min<int64_t>(el.count - first, (end_ - p_) / kRecordBytes);
+    if (available <= 0 || static_cast<uint8_t>(*p_) != 3) return first;  // sized for nothing
     const size_t base = mesh_.triangles.size();
     mesh_.triangles.resize(base + static_cast<size_t>(available));
     mesh_.source_polygon.resize(base + static_cast<size_t>(available));
@@ -650,18 +653,18 @@ class BinaryBody {
     int32_t* const polygons = mesh_.source_polygon.data() + base;
     // As unsigned, a negative int index is as far out of range as one past the last vertex.
     const auto vertices = static_cast<uint64_t>(vertex_count);
-    int64_t i = 0;
-    for (; i < available; ++i, p_ += kRecordBytes) {
+    int64_t k = 0;
+    for (; k < available; ++k, p_ += kRecordBytes) {
       const uint32_t a = load32(p_ + 1), b = load32(p_ + 5), c = load32(p_ + 9);
       if ((static_cast<uint8_t>(*p_) != 3) | (a >= vertices) | (b >= vertices) | (c >= vertices))
         break;
-      triangles[i] = {{static_cast<int32_t>(a), static_cast<int32_t>(b), static_cast<int32_t>(c)}};
-      polygons[i] = static_cast<int32_t>(i);
+      triangles[k] = {{static_cast<int32_t>(a), static_cast<int32_t>(b), static_cast<int32_t>(c)}};
+      polygons[k] = static_cast<int32_t>(first + k);
     }
-    mesh_.triangles.resize(base + static_cast<size_t>(i));
-    mesh_.source_polygon.resize(base + static_cast<size_t>(i));
-    mesh_.triangle_group.resize(base + static_cast<size_t>(i), -1);
-    return i;
+    mesh_.triangles.resize(base + static_cast<size_t>(k));
+    mesh_.source_polygon.resize(base + static_cast<size_t>(k));
+    mesh_.triangle_group.resize(base + static_cast<size_t>(k), -1);
+    return first + k;
   }
 
   [[noreturn]] [[gnu::noinline]] void bad_index(const Element& el, int64_t i, int64_t c, int64_t v,
