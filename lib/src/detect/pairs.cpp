@@ -15,9 +15,9 @@ namespace {
 
 /// How this file's least-significant-digit radix sorts cut keys of `bits` bits into digits: the
 /// fewest passes of digits of at most 12 bits (4,096 counts, 32 KB: in L1 with room to spare),
-/// the bits spread evenly over them. Cloth-ball's 34-bit keys take three passes of 12 bits where 11-bit
-/// digits took four (expand_hits on its frames 3.1-3.2 -> 2.5-2.8 ms on the 2-core EPYC), 36K's
-/// 32-bit keys three of 11 as before.
+/// the bits spread evenly over them. Cloth-ball's 34-bit keys take three passes of 12 bits where
+/// 11-bit digits took four (expand_hits on its frames 3.1-3.2 -> 2.5-2.8 ms on the 2-core EPYC),
+/// 36K's 32-bit keys three of 11 as before.
 struct RadixDigits {
   static constexpr int kMaxDigit = 12;
   int passes, digit;
