@@ -1,10 +1,11 @@
 // expand_hits against a brute-force set of its pairs, at several thread counts, on random
 // meshes with non-manifold edges and degenerate faces, large enough that every thread gets a
-// share of the listing and of each radix pass.
+// share of the listing and of each radix pass; merge_pairs against a map of both its lists.
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <algorithm>
+#include <map>
 #include <random>
 #include <set>
 #include <utility>
@@ -97,6 +98,47 @@ TEST(ExpandHits, NoHitsNoPairs) {
   const Topology topo = make_topology(triangles, 4);
   const std::vector<uint8_t> degenerate(2, 0);
   EXPECT_TRUE(expand_hits(topo, {}, degenerate, 4).empty());
+}
+
+// merge_pairs against a std::map built from both lists, the first list's kind and flag winning
+// on a pair both hold; and an empty second list leaving the first as it was.
+TEST(MergePairs, MatchesAMapOfBothListsTheFirstWinning) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int32_t> id(0, 40);
+  for (int round = 0; round < 200; ++round) {
+    std::map<std::pair<int32_t, int32_t>, std::pair<PairKind, uint8_t>> lists[2];
+    for (auto& list : lists) {
+      const int count = static_cast<int>(rng() % 30);
+      for (int i = 0; i < count; ++i) {
+        int32_t a = id(rng), b = id(rng);
+        if (a == b) continue;
+        if (a > b) std::swap(a, b);
+        list[{a, b}] = {rng() % 2 ? PairKind::crossing : PairKind::touching,
+                        static_cast<uint8_t>(rng() % 2)};
+      }
+    }
+    std::vector<FacePair> into, more;
+    std::vector<uint8_t> into_flags, more_flags;
+    for (const auto& [ids, value] : lists[0]) {
+      into.push_back({ids.first, ids.second, value.first});
+      into_flags.push_back(value.second);
+    }
+    for (const auto& [ids, value] : lists[1]) {
+      more.push_back({ids.first, ids.second, value.first});
+      more_flags.push_back(value.second);
+    }
+    auto expected = lists[1];
+    for (const auto& [ids, value] : lists[0]) expected[ids] = value;
+    merge_pairs(into, into_flags, more, more_flags);
+    ASSERT_EQ(into.size(), expected.size());
+    ASSERT_EQ(into_flags.size(), expected.size());
+    size_t i = 0;
+    for (const auto& [ids, value] : expected) {
+      EXPECT_EQ(into[i], (FacePair{ids.first, ids.second, value.first}));
+      EXPECT_EQ(into_flags[i], value.second);
+      ++i;
+    }
+  }
 }
 
 }  // namespace
