@@ -31,7 +31,9 @@ struct RadixDigits {
 
 /// Sorts and deduplicates keys below 2^bits with a radix sort (RadixDigits), on one thread:
 /// linear in the count, where a comparison sort of a frame's hundreds of thousands of hit pairs
-/// was a third of the frame.
+/// was a third of the frame. This is sorted_pairs_of_runs' sort for a single run, kept apart:
+/// that one with its parallel regions made conditional (`if (pieces > 1)`) still took 2,244
+/// triangles' exact + classify from 0.021-0.041 to 0.034-0.050 ms.
 void sort_unique(std::vector<uint64_t>& keys, int bits) {
   const RadixDigits radix(bits);
   std::vector<uint64_t> scratch(keys.size());
