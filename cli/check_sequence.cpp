@@ -715,6 +715,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       detect::FrameResult result =
           checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});
       lap(times.checking);
+      times.stages += result.times;
       recorder.add({std::move(*current), std::move(result), read_seconds});
       lap(behind);
 

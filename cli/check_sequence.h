@@ -23,6 +23,7 @@ struct LoopTimes {
   double waiting = 0;    ///< for the next frame, not yet read or compared
   double preparing = 0;  ///< a topology's set-up (weld decisions, the checker's scene, meters)
   double checking = 0;   ///< Checker::check, exact decisions included
+  detect::StageTimes stages;  ///< checking by the checker's own stage clocks (FrameResult::times)
   double recording = 0;  ///< the frame's record: ids, groups, penetration (on a GPU, beside
                          ///< the loop on the recording thread, one frame behind the checks)
   double handing = 0;    ///< on_frame (the report stream takes the record; where recording is)

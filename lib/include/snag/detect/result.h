@@ -37,6 +37,16 @@ struct StageTimes {
   /// covers their start, and their own stages only what was left.
   double scan = 0;
   double total() const { return scan + build + refit + traverse + exact + classify + confirm; }
+  StageTimes& operator+=(const StageTimes& other) {
+    build += other.build;
+    refit += other.refit;
+    traverse += other.traverse;
+    exact += other.exact;
+    classify += other.classify;
+    confirm += other.confirm;
+    scan += other.scan;
+    return *this;
+  }
 };
 
 /// One part (a scene's object) in one frame.
