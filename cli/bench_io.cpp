@@ -412,15 +412,18 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
       "scene);\nchecking = Checker::check; recording = the frame's record; handing = to the "
       "report stream\n(on a GPU these two are beside the loop, on the recording thread, and "
       "behind = the loop's\nwait for them); starting = of waiting and preparing, until the "
-      "first frame's check began;\nbeside the loop, comparing = on the preparing thread, each "
-      "frame's faces and positions\nagainst the frame before's\n");
-  std::printf("%-8s %9s %10s %9s %10s %9s %9s %9s %9s %10s\n", "backend", "waiting", "preparing",
-              "checking", "recording", "handing", "behind", "loop", "starting", "comparing");
+      "first frame's check began;\nbeside the loop, on the preparing thread: comparing = each "
+      "frame's faces and positions\nagainst the frame before's, staging = its positions copied "
+      "into the GPU's pinned memory\n");
+  std::printf("%-8s %9s %10s %9s %10s %9s %9s %9s %9s %10s %9s\n", "backend", "waiting",
+              "preparing", "checking", "recording", "handing", "behind", "loop", "starting",
+              "comparing", "staging");
   for (const SequenceRow& r : rows) {
     const LoopTimes& loop = r.both.loop;
-    std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %9.3f %10.3f\n",
+    std::printf("%-8s %9.3f %10.3f %9.3f %10.3f %9.3f %9.3f %9.3f %9.3f %10.3f %9.3f\n",
                 r.backend.c_str(), loop.waiting, loop.preparing, loop.checking, loop.recording,
-                loop.handing, loop.behind, r.both.times.wall, loop.starting, loop.comparing);
+                loop.handing, loop.behind, r.both.times.wall, loop.starting, loop.comparing,
+                loop.staging);
   }
   std::printf(
       "\nchecking by the checker's stage clocks (seconds): scan = the degenerate-triangle scan "

@@ -51,7 +51,17 @@ struct PreparedFrame {
   /// empty for the first frame.
   std::vector<uint8_t> moved;
   double comparing_seconds = 0;  ///< the preparing thread's time on it (reading's share)
-  std::exception_ptr error;      ///< reading or comparing it failed: thrown at its turn
+  /// Its positions copied into the backend's staging memory (a GPU's pinned buffers), when the
+  /// backend has such memory and a buffer was free; the check then passes this span, which the
+  /// backend transfers without a copy of its own on the checker's thread.
+  std::shared_ptr<const detect::StagedPositions> staged;
+  double staging_seconds = 0;  ///< the preparing thread's time copying it there
+  std::exception_ptr error;    ///< reading or comparing it failed: thrown at its turn
+
+  /// The positions to check: the staged copy, else the mesh's own.
+  std::span<const geom::Vec3d> positions() const {
+    return staged ? staged->positions() : std::span<const geom::Vec3d>(frame->item.mesh.positions);
+  }
 };
 
 /// Frames in order from the preparing thread to the checker's, at most `capacity` waiting, so
@@ -126,10 +136,11 @@ class FrameHandoff {
 
 /// The preparing thread: takes each frame in order from the readers, checks its objects'
 /// vertex counts against the first frame's and compares its faces and positions with the frame
-/// before's, and puts it into `handoff`. A failure (a bad file, a vertex count that changed, or
-/// anything thrown here) closes the handoff with it, to be thrown at that frame's turn.
+/// before's, stages its positions (when `staging` is given), and puts it into `handoff`. A
+/// failure (a bad file, a vertex count that changed, or anything thrown here) closes the handoff
+/// with it, to be thrown at that frame's turn.
 void prepare_frames(ScenePrefetcher& prefetcher, const scene::ResolvedScene& scene,
-                    bool scene_report, FrameHandoff& handoff) {
+                    bool scene_report, detect::HostStaging* staging, FrameHandoff& handoff) {
   try {
     std::shared_ptr<const ScenePrefetcher::Prefetched> previous;
     std::vector<int32_t> first_vertices;  // per object, the first frame's vertex count
@@ -168,6 +179,11 @@ void prepare_frames(ScenePrefetcher& prefetcher, const scene::ResolvedScene& sce
       }
       prepared.frame = frame;
       prepared.comparing_seconds = seconds_since(started);
+      if (staging) {
+        const auto staging_started = Clock::now();
+        prepared.staged = staging->stage(scene_frame.mesh.positions);
+        prepared.staging_seconds = seconds_since(staging_started);
+      }
       previous = std::move(frame);
       if (!handoff.put(std::move(prepared))) return;  // the checker's thread stopped
     }
@@ -545,8 +561,14 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   // wait between the two.
   constexpr size_t kPrepared = 2;
   FrameHandoff handoff(kPrepared);
+  // Frames prepared and not yet recorded hold a staging buffer each: kPrepared waiting, the
+  // preparing thread's current, this thread's current and following, and the recording
+  // thread's; one more for a frame between two of these. A frame that finds none free is
+  // transferred as any other.
+  const std::shared_ptr<detect::HostStaging> staging =
+      checker.host_staging(static_cast<int>(kPrepared) + 5);
   const PreparingThread preparing(
-      handoff, [&] { prepare_frames(prefetcher, scene, scene_report, handoff); });
+      handoff, [&] { prepare_frames(prefetcher, scene, scene_report, staging.get(), handoff); });
   LoopTimes times;
   auto mark = Clock::now();
   // Adds the time since the last mark to `slot`.
@@ -698,6 +720,7 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       const double read_seconds =
           current->frame->read_seconds + current->comparing_seconds + seconds_since(read_started);
       times.comparing += current->comparing_seconds;
+      times.staging += current->staging_seconds;
 
       // What moved since the frame before (not asked for a topology's first frame), and the next
       // frame's positions and what moved in them since this one.
@@ -706,14 +729,14 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       std::span<const geom::Vec3d> next_positions;
       std::span<const uint8_t> next_moved;
       if (following && following->frame) {
-        next_positions = following->frame->item.mesh.positions;
+        next_positions = following->positions();
         next_moved = following->moved;
       }
       lap(times.preparing);
       if (i == 0) times.starting = times.waiting + times.preparing;
       // Read by snag's readers, which reject non-finite coordinates.
       detect::FrameResult result =
-          checker.check({mesh.positions, moved, next_positions, next_moved, /*finite=*/true});
+          checker.check({current->positions(), moved, next_positions, next_moved, /*finite=*/true});
       lap(times.checking);
       times.stages += result.times;
       recorder.add({std::move(*current), std::move(result), read_seconds});

@@ -31,6 +31,8 @@ struct LoopTimes {
   double starting = 0;   ///< of waiting and preparing, until the first frame's check began
   double comparing = 0;  ///< on the preparing thread: vertex counts, faces and what moved,
                          ///< each frame against the one before (reading's share)
+  double staging = 0;    ///< on the preparing thread: positions copied into the backend's
+                         ///< staging memory (a GPU's pinned buffers; none on the CPU)
 };
 
 struct SequenceSettings {

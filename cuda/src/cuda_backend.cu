@@ -15,6 +15,7 @@
 #include "device_buffer.cuh"
 #include "device_topology.cuh"
 #include "device_tree.cuh"
+#include "host_staging.cuh"
 #include "snag/error.h"
 #include "trace.cuh"
 
@@ -49,7 +50,7 @@ struct SelectDevice {
 
 class CudaBackendImpl final : public CudaBackend {
  public:
-  explicit CudaBackendImpl(int device) : select_(device) {
+  explicit CudaBackendImpl(int device) : select_(device), device_(device) {
     cudaDeviceProp prop{};
     SNAG_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
     device_name_ = prop.name;
@@ -269,6 +270,11 @@ class CudaBackendImpl final : public CudaBackend {
     staged_version_ = versions;
   }
 
+  std::shared_ptr<detect::HostStaging> host_staging(int buffers) override {
+    if (!staging_) staging_ = std::make_shared<PinnedStaging>(device_, buffers);
+    return staging_;
+  }
+
   void upload_resident_frames(std::span<const std::span<const geom::Vec3d>> frames) override {
     require_topology();
     const size_t v = static_cast<size_t>(topo_.vertex_count);
@@ -471,13 +477,16 @@ class CudaBackendImpl final : public CudaBackend {
     return true;
   }
 
-  /// Copies into `slot` (through its pinned buffer) the vertices of every part whose version
-  /// there is not `versions`' (neighbouring parts in one copy), on `s`, and records the slot's
-  /// new versions.
+  /// Copies into `slot` the vertices of every part whose version there is not `versions'`
+  /// (neighbouring parts in one copy), on `s`, and records the slot's new versions. Positions
+  /// staged in pinned memory (host_staging) go straight across; others through the slot's own
+  /// pinned buffer, copied into it here.
   void copy_stale_parts(std::span<const geom::Vec3d> positions, int slot,
                         const std::vector<uint64_t>& versions, cudaStream_t s) {
     const auto& vertex_begin = topology_->layout.vertex_begin;
     const int32_t parts = static_cast<int32_t>(part_.size());
+    const bool staged = staging_ && staging_->holds(positions);
+    bool transferred = false;
     for (int32_t p = 0; p < parts;) {
       if (slot_version_[slot][p] == versions[p]) {
         ++p;
@@ -489,14 +498,18 @@ class CudaBackendImpl final : public CudaBackend {
       const size_t first = static_cast<size_t>(vertex_begin[p]);
       const size_t count = static_cast<size_t>(vertex_begin[q]) - first;
       if (count) {
-        std::memcpy(positions_host_[slot].data() + first, positions.data() + first,
-                    count * sizeof(geom::Vec3d));
-        SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first,
-                                        positions_host_[slot].data() + first,
+        const geom::Vec3d* source = positions.data() + first;
+        if (!staged) {
+          std::memcpy(positions_host_[slot].data() + first, source, count * sizeof(geom::Vec3d));
+          source = positions_host_[slot].data() + first;
+        }
+        SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first, source,
                                         count * sizeof(geom::Vec3d), cudaMemcpyHostToDevice, s));
+        transferred = true;
       }
       p = q;
     }
+    if (staged && transferred) staging_->note_read(positions, s);
   }
 
   cudaStream_t stream() const { return stream_->get(); }
@@ -736,7 +749,11 @@ class CudaBackendImpl final : public CudaBackend {
   };
 
   SelectDevice select_;
+  int device_ = 0;
   std::string device_name_;
+  /// Pinned buffers a caller stages frames' positions in (host_staging): copy_stale_parts
+  /// transfers spans inside them directly.
+  std::shared_ptr<PinnedStaging> staging_;
   std::unique_ptr<Stream> stream_;
   EventTimer timer_, span_timer_;
   mutable StageTimes times_;

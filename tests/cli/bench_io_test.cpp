@@ -36,9 +36,10 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   EXPECT_GT(std::stod(cpu[3]), 0);  // snag check, seconds
   // Where the loop's time went: six shares, none negative, adding up to no more than the loop
   // (on the CPU the records are made on the loop's thread: nothing behind); then the start,
-  // part of waiting and preparing, and the preparing thread's comparisons beside the loop.
+  // part of waiting and preparing, and the preparing thread's comparisons and staging beside
+  // the loop (nothing staged on the CPU).
   const std::vector<std::string> loop = table_row(r.out, "cpu ", 1);
-  ASSERT_EQ(loop.size(), 9u);
+  ASSERT_EQ(loop.size(), 10u);
   double shares = 0;
   for (size_t i = 0; i < 6; ++i) {
     EXPECT_GE(std::stod(loop[i]), 0) << i;
@@ -51,6 +52,18 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   EXPECT_GE(std::stod(loop[7]), 0);  // starting, of waiting and preparing
   EXPECT_LE(std::stod(loop[7]), std::stod(loop[0]) + std::stod(loop[1]) + 0.001);
   EXPECT_GE(std::stod(loop[8]), 0);  // comparing (microseconds a frame here)
+  EXPECT_EQ(loop[9], "0.000");       // staging
+  // Checking by the checker's stage clocks: none negative, the traversal's among them, and
+  // with what they leave (other) adding up to checking.
+  const std::vector<std::string> stages = table_row(r.out, "cpu ", 2);
+  ASSERT_EQ(stages.size(), 7u);
+  double staged = 0;
+  for (size_t i = 0; i < 7; ++i) {
+    EXPECT_GE(std::stod(stages[i]), -0.0005) << i;  // "other" may round to -0.000
+    staged += std::stod(stages[i]);
+  }
+  EXPECT_GT(std::stod(stages[3]), 0);  // traverse
+  EXPECT_NEAR(staged, std::stod(loop[2]), 0.004);
   for (const char* frames : {"       2 ", "       8 "})
     EXPECT_EQ(table_row(r.out, frames).size(), 3u) << frames;
 }

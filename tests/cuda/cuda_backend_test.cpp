@@ -572,6 +572,129 @@ TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
   }
 }
 
+TEST(CudaBackend, HostStagingHandsOutCopiesHeldUntilDropped) {
+  SNAG_REQUIRE_GPU();
+  // The pinned buffers a sequence's preparing thread stages positions in: each a copy at its
+  // own address, held until its pointer is dropped, none when all are held (never a wait), a
+  // buffer given back used again and grown for a larger frame; one staging per backend.
+  auto gpu = gpu_backend();
+  const std::shared_ptr<detect::HostStaging> staging = gpu->host_staging(2);
+  ASSERT_NE(staging, nullptr);
+  EXPECT_EQ(gpu->host_staging(5), staging);
+  const std::vector<geom::Vec3d> small = folded_grid(6, 4).positions,
+                                 large = folded_grid(40, 30).positions;
+  auto as_vector = [](std::span<const geom::Vec3d> s) {
+    return std::vector<geom::Vec3d>(s.begin(), s.end());
+  };
+  std::shared_ptr<const detect::StagedPositions> a = staging->stage(small);
+  std::shared_ptr<const detect::StagedPositions> b = staging->stage(large);
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(as_vector(a->positions()), small);
+  EXPECT_EQ(as_vector(b->positions()), large);
+  EXPECT_NE(a->positions().data(), small.data());
+  EXPECT_NE(a->positions().data(), b->positions().data());
+  EXPECT_EQ(staging->stage(small), nullptr);  // both buffers held
+  a.reset();
+  a = staging->stage(large);  // the small frame's buffer, grown
+  const geom::Vec3d* was = a->positions().data();
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(as_vector(a->positions()), large);
+  EXPECT_EQ(as_vector(b->positions()), large);
+  EXPECT_NE(a->positions().data(), b->positions().data());
+  a.reset();
+  a = staging->stage(small);
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(a->positions().data(), was);  // given back again, used again
+  EXPECT_EQ(as_vector(a->positions()), small);
+  EXPECT_EQ(detect::make_cpu_backend(1)->host_staging(2), nullptr);  // nothing to stage
+}
+
+TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
+  SNAG_REQUIRE_GPU();
+  // A sequence checked as snag check's loop does on a GPU: each frame staged in pinned memory
+  // ahead of its check, its staged span checked and the next one's staged span passed ahead,
+  // the frame's buffer given back once checked, against the CPU and brute force. Buffers run
+  // out (some frames then unstaged), are used again by later frames, and one frame is staged
+  // in a buffer given back while the transfer out of it may still be queued: the staging waits
+  // for that transfer before it writes, so the frame checked is the one staged.
+  SmallMesh base = folded_grid(60, 20);
+  std::vector<SmallMesh> frames;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int f = 0; f < 10; ++f) {
+    frames.push_back(base);
+    for (auto& p : base.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+  }
+  auto resolver = std::make_shared<IntegerResolver>();
+  detect::Checker gpu(gpu_backend(), resolver);
+  detect::Checker cpu(detect::make_cpu_backend(2), resolver);
+  const int32_t vertices = static_cast<int32_t>(base.positions.size());
+  for (detect::Checker* c : {&gpu, &cpu}) c->set_triangles(base.triangles, vertices);
+  const std::shared_ptr<detect::HostStaging> staging = gpu.host_staging(2);
+  ASSERT_NE(staging, nullptr);
+  std::vector<std::shared_ptr<const detect::StagedPositions>> staged(frames.size());
+  auto positions = [&](size_t f) {
+    return staged[f] ? staged[f]->positions() : std::span<const geom::Vec3d>(frames[f].positions);
+  };
+  staged[0] = staging->stage(frames[0].positions);
+  int unstaged = 0;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    // Frames 4 and 5 hold a buffer for longer: 6 then finds none free.
+    if (f + 1 < frames.size() && !staged[f + 1])
+      staged[f + 1] = staging->stage(frames[f + 1].positions);
+    unstaged += staged[f] == nullptr;
+    const std::span<const geom::Vec3d> next =
+        f + 1 < frames.size() ? positions(f + 1) : std::span<const geom::Vec3d>();
+    const detect::FrameResult g = gpu.check(positions(f), next);
+    const detect::FrameResult c = cpu.check(frames[f].positions);
+    EXPECT_EQ(g.pairs, c.pairs) << "frame " << f;
+    EXPECT_EQ(g.degenerate, c.degenerate) << "frame " << f;
+    EXPECT_EQ(g.tree_quality, c.tree_quality) << "frame " << f;
+    EXPECT_EQ(g.pairs, brute_force(frames[f])) << "frame " << f;
+    if (f != 4) staged[f].reset();
+    if (f == 6) staged[4].reset();
+  }
+  EXPECT_GT(unstaged, 0);
+  EXPECT_LT(unstaged, 5);
+
+  // One buffer: a frame's transfer queued from it (set_positions returns at once), the frame
+  // given back and another staged over it at once, then the first frame checked. A big frame
+  // (60K vertices, a height field: no pairs), so that the transfer is still running when the
+  // second copy would start; the other frame stretched unevenly, so that its tree's quality
+  // and its candidate pairs differ (and so would any mixture of the two).
+  const SmallMesh big = grid_mesh(400, 150, [](int i, int j) {
+    return geom::Vec3d{double(i), double(j), double((i * j) % 5)};
+  });
+  SmallMesh moved = big;
+  for (geom::Vec3d& p : moved.positions) p = geom::Vec3d{3 * p.x, p.y, 2 * p.z + 1};
+  const detect::Topology topology =
+      detect::make_topology(big.triangles, static_cast<int32_t>(big.positions.size()));
+  auto plain = detect::make_cpu_backend(2);
+  plain->set_topology(topology);
+  const Filtered expected = filtered(*plain, big.positions, true);
+  for (int round = 0; round < 5; ++round) {
+    auto alone = gpu_backend();
+    alone->set_topology(topology);
+    const std::shared_ptr<detect::HostStaging> one = alone->host_staging(1);
+    std::shared_ptr<const detect::StagedPositions> first = one->stage(big.positions);
+    ASSERT_NE(first, nullptr);
+    alone->set_positions(first->positions());
+    const geom::Vec3d* buffer = first->positions().data();
+    first.reset();
+    const std::shared_ptr<const detect::StagedPositions> second = one->stage(moved.positions);
+    ASSERT_NE(second, nullptr);
+    EXPECT_EQ(second->positions().data(), buffer);  // the same buffer, written over
+    Filtered got;
+    got.scan = alone->scan_degenerate();
+    alone->build();
+    got.quality = alone->tree_quality();
+    got.frame = alone->detect(got.scan.degenerate);
+    expect_same(expected, got, "round " + std::to_string(round));
+  }
+}
+
 /// Frames of a folded grid scaled by 4, each vertex stepping by -1, 0 or 1 per axis per frame,
 /// a step undone where it would leave a triangle of zero area (so that consecutive frames have
 /// the same, empty, degenerate list and a detect queued ahead can be taken).

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,28 @@ inline std::vector<int32_t> all_indices(int32_t count) {
   return all;
 }
 
+/// A frame's positions in a backend's staging memory (HostStaging::stage), held until the last
+/// pointer to them is dropped.
+class StagedPositions {
+ public:
+  virtual ~StagedPositions() = default;
+  virtual std::span<const geom::Vec3d> positions() const = 0;
+};
+
+/// Host memory that a backend copies positions to its device from directly (page-locked memory
+/// on a GPU, where any other span is first copied into such memory on the checker's thread: ~40
+/// us for 18K vertices). A caller that stages a frame's positions there on another thread,
+/// ahead of its check, and passes the staged span to set_part_positions() and
+/// stage_part_positions(), takes that copy off the checker's thread. stage() may be called from
+/// any thread, beside the backend's own calls.
+class HostStaging {
+ public:
+  virtual ~HostStaging() = default;
+  /// A copy of `positions` in staging memory; null when every buffer is held (that frame is
+  /// then copied as any other). Never waits for a buffer to be given back.
+  virtual std::shared_ptr<const StagedPositions> stage(std::span<const geom::Vec3d> positions) = 0;
+};
+
 /// A backend works on one topology of one or more parts (topology.h): one tree per part,
 /// built, refit and measured part by part, and the topology's checks run as the caller picks
 /// them, so that a part that did not move costs nothing.
@@ -68,6 +91,12 @@ class Backend {
                                     std::span<const uint8_t> moved) {
     (void)next;
     (void)moved;
+  }
+  /// Staging memory for up to `buffers` frames held at once (HostStaging), or null when this
+  /// backend has nothing to copy (the CPU's). One per backend: later calls return the first's.
+  virtual std::shared_ptr<HostStaging> host_staging(int buffers) {
+    (void)buffers;
+    return nullptr;
   }
   /// Triangles of these parts of zero area as far as the filter can tell.
   virtual DegeneracyScan scan_degenerate_parts(std::span<const int32_t> parts) = 0;

@@ -80,6 +80,9 @@ class Checker {
     return check(FrameInput{positions, {}, next_positions, {}});
   }
 
+  /// The backend's staging memory for frames' positions (Backend::host_staging), or null.
+  std::shared_ptr<HostStaging> host_staging(int buffers) { return backend_->host_staging(buffers); }
+
   /// Tree builds beyond the first of each part of each topology.
   int rebuild_count() const { return rebuilds_; }
   int build_count() const { return builds_; }  ///< tree builds, every part's

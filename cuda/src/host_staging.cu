@@ -1,0 +1,89 @@
+#include "host_staging.cuh"
+
+#include <algorithm>
+#include <cstring>
+
+namespace snag::cuda {
+
+/// A frame's positions in one of the buffers, which comes back when this is dropped.
+class PinnedStaging::Staged final : public detect::StagedPositions {
+ public:
+  Staged(std::shared_ptr<PinnedStaging> staging, Buffer* buffer, size_t count)
+      : staging_(std::move(staging)), buffer_(buffer), count_(count) {}
+  ~Staged() override { staging_->give_back(buffer_); }
+  Staged(const Staged&) = delete;
+  Staged& operator=(const Staged&) = delete;
+  std::span<const geom::Vec3d> positions() const override {
+    return {buffer_->memory.data(), count_};
+  }
+
+ private:
+  std::shared_ptr<PinnedStaging> staging_;  // the buffers outlive every frame staged in them
+  Buffer* buffer_;
+  size_t count_;
+};
+
+PinnedStaging::PinnedStaging(int device, int buffers)
+    : device_(device), most_buffers_(static_cast<size_t>(std::max(buffers, 1))) {}
+
+std::shared_ptr<const detect::StagedPositions> PinnedStaging::stage(
+    std::span<const geom::Vec3d> positions) {
+  Buffer* buffer = nullptr;
+  {
+    std::lock_guard lock(mutex_);
+    for (const std::unique_ptr<Buffer>& b : buffers_)
+      if (!b->held) {
+        buffer = b.get();
+        break;
+      }
+    if (!buffer && buffers_.size() < most_buffers_) {
+      // Created on the calling thread (the preparing thread): on the backend's device.
+      SNAG_CUDA_CHECK(cudaSetDevice(device_));
+      buffers_.push_back(std::make_unique<Buffer>());
+      buffer = buffers_.back().get();
+    }
+    if (!buffer) return nullptr;
+    buffer->held = true;
+  }
+  // Held now: no other thread touches the buffer until it is given back. On any failure below
+  // it is given back at once (the Staged pointer does it).
+  auto staged = std::make_shared<const Staged>(shared_from_this(), buffer, positions.size());
+  buffer->read.synchronize();  // the last transfer out of it (long done, in a frame loop)
+  if (positions.size() > buffer->memory.capacity()) {
+    SNAG_CUDA_CHECK(cudaSetDevice(device_));
+    buffer->memory.reserve(positions.size());
+  }
+  if (!positions.empty())
+    std::memcpy(buffer->memory.data(), positions.data(), positions.size_bytes());
+  return staged;
+}
+
+PinnedStaging::Buffer* PinnedStaging::find(const geom::Vec3d* data, size_t count) const {
+  for (const std::unique_ptr<Buffer>& b : buffers_) {
+    const geom::Vec3d* begin = b->memory.data();
+    // Pointers into different allocations are compared as addresses (std::less is a total
+    // order on pointers; the built-in < is not for unrelated ones).
+    if (begin && !std::less<const geom::Vec3d*>()(data, begin) &&
+        !std::less<const geom::Vec3d*>()(begin + b->memory.capacity(), data + count))
+      return b.get();
+  }
+  return nullptr;
+}
+
+bool PinnedStaging::holds(std::span<const geom::Vec3d> positions) const {
+  if (positions.empty()) return false;
+  std::lock_guard lock(mutex_);
+  return find(positions.data(), positions.size()) != nullptr;
+}
+
+void PinnedStaging::note_read(std::span<const geom::Vec3d> positions, cudaStream_t stream) {
+  std::lock_guard lock(mutex_);
+  if (Buffer* buffer = find(positions.data(), positions.size())) buffer->read.record(stream);
+}
+
+void PinnedStaging::give_back(Buffer* buffer) {
+  std::lock_guard lock(mutex_);
+  buffer->held = false;
+}
+
+}  // namespace snag::cuda
