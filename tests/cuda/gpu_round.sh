@@ -2,8 +2,8 @@
 # One round on a GPU machine, from the repository root, with the build staged into .gpu by
 # tests/cuda/stage.sh (here: tests/cuda/stage.sh build-gpu), carried as .gpu:
 #   tests/cuda/gpu_round.sh [tests] [sanitize] [reports] [bench] [bench-quick] [bench-ab]
-#                           [accuracy] [io]
-# (bench-ab also needs an earlier commit's snag staged as .gpu/base/snag.)
+#                           [accuracy] [io] [io-ab]
+# (bench-ab and io-ab also need an earlier commit's snag staged as .gpu/base/snag.)
 # Logs go to $OUT (or ./out); a short table is printed last.
 set -uo pipefail
 out=${OUT:-out}; mkdir -p "$out"
@@ -86,6 +86,21 @@ for step in "${steps[@]}"; do
       done
       summary+=("bench gpu (A/B)   base and new twice each: $out/bench_ab.txt")
       ;;
+    io-ab)
+      # snag bench io (IO_ARGS) of the binary staged as .gpu/base/snag and of this build's,
+      # alternating, twice each; the sequence tables' rows are collected.
+      [ -x .gpu/base/snag ] || { summary+=("io-ab             skipped: no .gpu/base/snag"); continue; }
+      for r in 1 2; do
+        for v in base new; do
+          bin=snag; [ $v = base ] && bin=.gpu/base/snag
+          # shellcheck disable=SC2086  # IO_ARGS is several arguments
+          timeout 300 $bin bench io --data "$SNAG_DATA_DIR" ${IO_ARGS:-} >"$out/io_$v$r.txt" 2>"$out/io_$v$r.err"
+          echo "== $v$r rc=$?" >>"$out/io_ab.txt"
+          grep -E '^(Sequence|cpu |cuda )' "$out/io_$v$r.txt" >>"$out/io_ab.txt"
+        done
+      done
+      summary+=("bench io (A/B)    base and new twice each: $out/io_ab.txt")
+      ;;
     bench-quick)
       snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
       summary+=("bench gpu (quick) rc=$rc")
@@ -95,5 +110,6 @@ for step in "${steps[@]}"; do
 done
 [ -f "$out/bench_gpu.txt" ] && cat "$out/bench_gpu.txt"
 [ -f "$out/bench_ab.txt" ] && cat "$out/bench_ab.txt"
+[ -f "$out/io_ab.txt" ] && cat "$out/io_ab.txt"
 [ -f "$out/bench_io.txt" ] && cat "$out/bench_io.txt"
 printf '%s\n' "${summary[@]}"
