@@ -500,7 +500,8 @@ class CudaBackendImpl final : public CudaBackend {
       if (count) {
         const geom::Vec3d* source = positions.data() + first;
         if (!staged) {
-          std::memcpy(positions_host_[slot].data() + first, source, count * sizeof(geom::Vec3d));
+          copy_for_transfer(positions_host_[slot].data() + first, source,
+                            count * sizeof(geom::Vec3d));
           source = positions_host_[slot].data() + first;
         }
         SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first, source,

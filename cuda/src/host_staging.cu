@@ -1,9 +1,14 @@
 #include "host_staging.cuh"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
+#if defined(__x86_64__)
+#include <emmintrin.h>
+#endif
 
 namespace snag::cuda {
+
 
 /// A frame's positions in one of the buffers, which comes back when this is dropped.
 class PinnedStaging::Staged final : public detect::StagedPositions {
@@ -54,8 +59,26 @@ std::shared_ptr<const detect::StagedPositions> PinnedStaging::stage(
     buffer->memory.reserve(positions.size());
   }
   if (!positions.empty())
-    std::memcpy(buffer->memory.data(), positions.data(), positions.size_bytes());
+    copy_for_transfer(buffer->memory.data(), positions.data(), positions.size_bytes());
   return staged;
+}
+
+void copy_for_transfer(void* to, const void* from, size_t bytes) {
+#if defined(__x86_64__)
+  auto* out = static_cast<char*>(to);
+  const auto* in = static_cast<const char*>(from);
+  // Up to the first 16-byte boundary of the target by memcpy, then 16 bytes a store.
+  const size_t head = std::min(bytes, (16 - reinterpret_cast<uintptr_t>(out) % 16) % 16);
+  std::memcpy(out, in, head);
+  const size_t whole = head + (bytes - head) / 16 * 16;
+  for (size_t i = head; i < whole; i += 16)
+    _mm_stream_si128(reinterpret_cast<__m128i*>(out + i),
+                     _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i)));
+  _mm_sfence();  // the streamed stores are visible before the buffer is handed over
+  std::memcpy(out + whole, in + whole, bytes - whole);
+#else
+  std::memcpy(to, from, bytes);
+#endif
 }
 
 PinnedStaging::Buffer* PinnedStaging::find(const geom::Vec3d* data, size_t count) const {
