@@ -430,17 +430,19 @@ void sequence_table(const std::string& name, const std::vector<seq::Frame>& fram
   }
   std::printf(
       "\nchecking by the checker's stage clocks (seconds): scan = the degenerate-triangle scan "
-      "(on a GPU\nalso the next frame's copy into pinned memory, and the wait for the work "
-      "queued ahead); refit,\nbuild; traverse = traversal and narrow phase (on a GPU: the wait "
-      "for the device); classify\n(on a GPU: the next frame's work queued, the results "
-      "decoded); exact; other = the rest of\nchecking\n");
+      "(on a GPU\nalso the next frame's transfer queued, copied into pinned memory first when "
+      "it was not\nstaged, and the wait for the work queued ahead); refit; build; traverse = "
+      "traversal and narrow\nphase (on a GPU: the wait for the device); classify (on a GPU: the "
+      "next frame's work queued,\nthe results decoded); exact = exact decisions and (--exact "
+      "all) the confirmation; other =\nthe rest of checking\n");
   std::printf("%-8s %9s %9s %9s %9s %9s %9s %9s\n", "backend", "scan", "refit", "build", "traverse",
               "classify", "exact", "other");
   for (const SequenceRow& r : rows) {
     const LoopTimes& loop = r.both.loop;
     const detect::StageTimes& s = loop.stages;
     std::printf("%-8s %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f\n", r.backend.c_str(), s.scan,
-                s.refit, s.build, s.traverse, s.classify, s.exact, loop.checking - s.total());
+                s.refit, s.build, s.traverse, s.classify, s.exact + s.confirm,
+                loop.checking - s.total());
   }
 
   // The loop's floor: a schedule that spends the loop's CPU time on the machine's logical CPUs

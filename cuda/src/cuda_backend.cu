@@ -243,8 +243,9 @@ class CudaBackendImpl final : public CudaBackend {
   /// stream, alongside the current frame's kernels. That slot held the previous frame, whose
   /// work is all queued before this point on the main stream: the transfer waits for it (for
   /// the point where it ended, when the current frame's work was queued ahead after it). The
-  /// host's copy into pinned memory (~40 us for 36K triangles) waits until the current frame's
-  /// work is queued (copy_staged_positions, from the scan's wait, else from detect's or the next
+  /// host's copy into pinned memory (40-80 us for 36K triangles; none for positions staged in
+  /// pinned memory already, host_staging) and the transfer wait until the current frame's work
+  /// is queued (copy_staged_positions, from the scan's wait, else from detect's or the next
   /// set): done here, a checker's frame began with it while the device had nothing to do. Parts
   /// whose version that slot holds already are not copied.
   void stage_part_positions(std::span<const geom::Vec3d> next,
@@ -486,7 +487,23 @@ class CudaBackendImpl final : public CudaBackend {
     const auto& vertex_begin = topology_->layout.vertex_begin;
     const int32_t parts = static_cast<int32_t>(part_.size());
     const bool staged = staging_ && staging_->holds(positions);
-    bool transferred = false;
+    // Set once a transfer out of a staging buffer is queued: its read event is then recorded
+    // on every way out, an exception's included (the frame, and with it the buffer, may be
+    // dropped at once, and the preparing thread write the buffer again).
+    bool read_queued = false;
+    struct NoteReadOnThrow {
+      PinnedStaging* staging;
+      std::span<const geom::Vec3d> positions;
+      cudaStream_t stream;
+      bool& armed;
+      ~NoteReadOnThrow() {
+        if (!armed) return;
+        try {
+          staging->note_read(positions, stream);
+        } catch (...) {  // the CUDA error already being thrown says more
+        }
+      }
+    } on_throw{staging_.get(), positions, s, read_queued};
     for (int32_t p = 0; p < parts;) {
       if (slot_version_[slot][p] == versions[p]) {
         ++p;
@@ -506,16 +523,20 @@ class CudaBackendImpl final : public CudaBackend {
         }
         SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first, source,
                                         count * sizeof(geom::Vec3d), cudaMemcpyHostToDevice, s));
-        transferred = true;
+        read_queued = staged;
       }
       p = q;
     }
-    if (staged && transferred) staging_->note_read(positions, s);
+    if (read_queued) {
+      read_queued = false;
+      staging_->note_read(positions, s);
+    }
   }
 
   cudaStream_t stream() const { return stream_->get(); }
 
-  /// Copies the staged frame into pinned memory and queues its transfer, when stage_part_positions
+  /// Copies the staged frame into pinned memory (unless it is in the staging's already) and
+  /// queues its transfer, when stage_part_positions
   /// left that to do: from this frame's scan or detect, while the staged span is valid (until
   /// the next set_part_positions), or from that set when it is given the same span. A staged
   /// frame that is not the next one set is forgotten without being read (drop_staged_positions):

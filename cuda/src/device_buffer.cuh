@@ -67,6 +67,10 @@ class PinnedBuffer {
   }
   T* data() const { return data_; }
   size_t capacity() const { return capacity_; }
+  void swap(PinnedBuffer& other) noexcept {
+    std::swap(data_, other.data_);
+    std::swap(capacity_, other.capacity_);
+  }
 
  private:
   void release() noexcept {

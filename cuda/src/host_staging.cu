@@ -33,6 +33,10 @@ PinnedStaging::PinnedStaging(int device, int buffers)
 
 std::shared_ptr<const detect::StagedPositions> PinnedStaging::stage(
     std::span<const geom::Vec3d> positions) {
+  // Every call, not only those that allocate: a thread that never selected the device (a later
+  // run's preparing thread, the buffers made already) would otherwise have its first CUDA call
+  // below (the event's synchronize) start device 0's context.
+  SNAG_CUDA_CHECK(cudaSetDevice(device_));
   Buffer* buffer = nullptr;
   {
     std::lock_guard lock(mutex_);
@@ -43,21 +47,38 @@ std::shared_ptr<const detect::StagedPositions> PinnedStaging::stage(
       }
     if (!buffer && buffers_.size() < most_buffers_) {
       // Created on the calling thread (the preparing thread): on the backend's device.
-      SNAG_CUDA_CHECK(cudaSetDevice(device_));
       buffers_.push_back(std::make_unique<Buffer>());
       buffer = buffers_.back().get();
     }
     if (!buffer) return nullptr;
     buffer->held = true;
   }
-  // Held now: no other thread touches the buffer until it is given back. On any failure below
-  // it is given back at once (the Staged pointer does it).
-  auto staged = std::make_shared<const Staged>(shared_from_this(), buffer, positions.size());
+  // Held now: no other thread writes the buffer's contents until it is given back, but the
+  // checker's thread reads every buffer's address and capacity (find(), under mutex_), so
+  // those change only under mutex_. On any failure below it is given back at once (the Staged
+  // pointer does it).
+  std::shared_ptr<const Staged> staged;
+  try {
+    staged = std::make_shared<const Staged>(shared_from_this(), buffer, positions.size());
+  } catch (...) {
+    give_back(buffer);
+    throw;
+  }
   buffer->read.synchronize();  // the last transfer out of it (long done, in a frame loop)
   if (positions.size() > buffer->memory.capacity()) {
-    SNAG_CUDA_CHECK(cudaSetDevice(device_));
-    buffer->memory.reserve(positions.size());
-  }
+    PinnedBuffer<geom::Vec3d> larger;  // allocated outside the lock: find() does not wait
+    try {
+      larger.reserve(positions.size());
+    } catch (const InternalError&) {
+      // Page-locked memory refused (a limit on locked memory, say): this frame goes unstaged,
+      // transferred as any other, and the buffer comes back as it was.
+      return nullptr;
+    }
+    {
+      std::lock_guard lock(mutex_);
+      buffer->memory.swap(larger);
+    }
+  }  // the smaller allocation is freed here, outside the lock
   if (!positions.empty())
     copy_for_transfer(buffer->memory.data(), positions.data(), positions.size_bytes());
   return staged;

@@ -5,7 +5,9 @@
 // A buffer is held by the frame staged in it (the StagedPositions pointer) and comes back when
 // that pointer is dropped; it is written again only once the last transfer the backend queued
 // from it (note_read) is done. Buffers are allocated on first use, up to the count asked for,
-// and grown when a frame needs more room; none is freed before the staging itself.
+// and grown when a frame needs more room; none is freed before the staging itself, which the
+// backend holds for its life (a sequence loop asks for 7: 7 frames' positions of page-locked
+// memory, 3 MB at 18K vertices).
 #pragma once
 
 #include <cuda_runtime.h>

@@ -62,7 +62,9 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
     EXPECT_GE(std::stod(stages[i]), -0.0005) << i;  // "other" may round to -0.000
     staged += std::stod(stages[i]);
   }
-  EXPECT_GT(std::stod(stages[3]), 0);  // traverse
+  // traverse: 8 frames of 800 triangles sum to ~0.3-1.4 ms here, so it prints 0.000 as often as
+  // not (without OMP_WAIT_POLICY=passive nearly always): not asserted positive.
+  EXPECT_GE(std::stod(stages[3]), 0);
   EXPECT_NEAR(staged, std::stod(loop[2]), 0.004);
   for (const char* frames : {"       2 ", "       8 "})
     EXPECT_EQ(table_row(r.out, frames).size(), 3u) << frames;

@@ -597,8 +597,8 @@ TEST(CudaBackend, HostStagingHandsOutCopiesHeldUntilDropped) {
   EXPECT_EQ(staging->stage(small), nullptr);  // both buffers held
   a.reset();
   a = staging->stage(large);  // the small frame's buffer, grown
-  const geom::Vec3d* was = a->positions().data();
   ASSERT_NE(a, nullptr);
+  const geom::Vec3d* was = a->positions().data();
   EXPECT_EQ(as_vector(a->positions()), large);
   EXPECT_EQ(as_vector(b->positions()), large);
   EXPECT_NE(a->positions().data(), b->positions().data());
@@ -678,6 +678,11 @@ TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
     auto alone = gpu_backend();
     alone->set_topology(topology);
     const std::shared_ptr<detect::HostStaging> one = alone->host_staging(1);
+    // A build queued first (nothing in build() waits for it) holds the transfer back on the
+    // stream, so that the second copy below starts before the transfer does: without the
+    // staging's wait for it, the transfer reads the second frame, whatever the bus's speed.
+    alone->set_positions(moved.positions);
+    alone->build();
     std::shared_ptr<const detect::StagedPositions> first = one->stage(big.positions);
     ASSERT_NE(first, nullptr);
     alone->set_positions(first->positions());
