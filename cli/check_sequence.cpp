@@ -520,6 +520,9 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
                         " objects");
   std::vector<Meter> meters;
   bool any_assimp = false;
+  // A run of this checker cut short by an error may have left its next frame staged, in memory
+  // given back since (a staging buffer, a frame's vector) that this run's frames may reuse.
+  checker.forget_next_frame();
 
   // Frames are read ahead on their own threads, each with its own FrameReaders (which parse
   // only positions while the faces stay those of their previous frame), while the current one

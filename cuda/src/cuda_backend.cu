@@ -250,6 +250,10 @@ class CudaBackendImpl final : public CudaBackend {
   /// whose version that slot holds already are not copied.
   void stage_part_positions(std::span<const geom::Vec3d> next,
                             std::span<const uint8_t> moved) override {
+    if (next.empty()) {  // forget a staged frame: its span may hold another one by now
+      drop_staged_positions();
+      return;
+    }
     require_topology();
     if (static_cast<int64_t>(next.size()) != topo_.vertex_count) return;  // not a next frame
     drop_staged_positions();

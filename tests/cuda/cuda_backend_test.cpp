@@ -702,6 +702,33 @@ TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
   }
 }
 
+TEST(CudaBackend, AForgottenNextFrameIsNotTakenForItsSpanLater) {
+  SNAG_REQUIRE_GPU();
+  // A run cut short after staging its next frame (copied across during the check) leaves it
+  // staged; its span may then hold another frame when a later run starts there. What snag
+  // check's loop does first, forget_next_frame(), drops it: the span's new contents are the
+  // frame checked. Without it the old copy would be taken (the two frames' pairs differ).
+  const SmallMesh folded = folded_grid(40, 12);
+  const SmallMesh flat = grid_mesh(40, 12, [](int i, int j) {
+    return geom::Vec3d{double(i), double(2 * j), 0.0};
+  });
+  ASSERT_EQ(folded.positions.size(), flat.positions.size());
+  ASSERT_FALSE(brute_force(folded).empty());
+  ASSERT_TRUE(brute_force(flat).empty());
+  detect::Checker gpu(gpu_backend(), std::make_shared<IntegerResolver>());
+  gpu.set_triangles(folded.triangles, static_cast<int32_t>(folded.positions.size()));
+  std::vector<geom::Vec3d> next = folded.positions;  // the span staged, then written over
+  const std::vector<geom::Vec3d> first = folded.positions;
+  EXPECT_EQ(gpu.check(first, next).pairs, brute_force(folded));
+  // The run stops here; the span gets another frame (same size: the same storage); a new run
+  // starts with it.
+  const geom::Vec3d* was = next.data();
+  next = flat.positions;
+  ASSERT_EQ(next.data(), was);
+  gpu.forget_next_frame();
+  EXPECT_EQ(gpu.check(next).pairs, brute_force(flat));
+}
+
 /// Frames of a folded grid scaled by 4, each vertex stepping by -1, 0 or 1 per axis per frame,
 /// a step undone where it would leave a triangle of zero area (so that consecutive frames have
 /// the same, empty, degenerate list and a detect queued ahead can be taken).

@@ -80,6 +80,11 @@ class Checker {
     return check(FrameInput{positions, {}, next_positions, {}});
   }
 
+  /// Forgets the next frame given to the last check() (FrameInput::next_positions), which a
+  /// caller whose run stopped before checking it must call before its span holds anything
+  /// else: else a later check() of the same span could take the copy made of the old contents.
+  void forget_next_frame() { backend_->stage_part_positions({}, {}); }
+
   /// The backend's staging memory for frames' positions (Backend::host_staging), or null.
   std::shared_ptr<HostStaging> host_staging(int buffers) { return backend_->host_staging(buffers); }
 
