@@ -526,21 +526,27 @@ TEST(CudaBackend, ResidentFramesGiveTheSameResultsAsUploadedOnes) {
   }
 }
 
+/// `count` frames of `base`, each vertex stepping by -2 to 2 per axis per frame.
+std::vector<SmallMesh> stepped_frames(SmallMesh base, int count, uint32_t seed) {
+  std::vector<SmallMesh> frames;
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> step(-2, 2);
+  for (int f = 0; f < count; ++f) {
+    frames.push_back(base);
+    for (auto& p : base.positions)
+      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
+  }
+  return frames;
+}
+
 TEST(CudaBackend, StagedNextFramesGiveTheResultsOfPlainUploads) {
   SNAG_REQUIRE_GPU();
   // A sequence checked with each next frame staged while the current one is checked, against
   // the CPU and brute force: staged frames used, a staged frame replaced by another, staging
   // skipped, a topology change after staging, and a big frame (copies long enough to overlap
   // the kernels) all give the plain answers.
-  SmallMesh base = folded_grid(60, 20);
-  std::vector<SmallMesh> frames;
-  std::mt19937 rng(5);
-  std::uniform_int_distribution<int> step(-2, 2);
-  for (int f = 0; f < 12; ++f) {
-    frames.push_back(base);
-    for (auto& p : base.positions)
-      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
-  }
+  const SmallMesh base = folded_grid(60, 20);
+  std::vector<SmallMesh> frames = stepped_frames(base, 12, 5);
   auto resolver = std::make_shared<IntegerResolver>();
   detect::Checker gpu(gpu_backend(), resolver);
   detect::Checker cpu(detect::make_cpu_backend(2), resolver);
@@ -614,19 +620,12 @@ TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
   SNAG_REQUIRE_GPU();
   // A sequence checked as snag check's loop does on a GPU: each frame staged in pinned memory
   // ahead of its check, its staged span checked and the next one's staged span passed ahead,
-  // the frame's buffer given back once checked, against the CPU and brute force. Buffers run
-  // out (some frames then unstaged), are used again by later frames, and one frame is staged
-  // in a buffer given back while the transfer out of it may still be queued: the staging waits
-  // for that transfer before it writes, so the frame checked is the one staged.
-  SmallMesh base = folded_grid(40, 12);  // brute force on every frame: kept small
-  std::vector<SmallMesh> frames;
-  std::mt19937 rng(11);
-  std::uniform_int_distribution<int> step(-2, 2);
-  for (int f = 0; f < 10; ++f) {
-    frames.push_back(base);
-    for (auto& p : base.positions)
-      p = p + geom::Vec3d{double(step(rng)), double(step(rng)), double(step(rng))};
-  }
+  // the frame's buffer given back once checked, against the CPU and brute force; buffers run
+  // out (some frames then unstaged) and are used again by later frames. Then a frame staged in
+  // a buffer given back while the transfer out of it is still queued: the staging waits for
+  // that transfer before it writes, so the frame checked is the one staged.
+  const SmallMesh base = folded_grid(40, 12);  // brute force on every frame: kept small
+  const std::vector<SmallMesh> frames = stepped_frames(base, 10, 11);
   auto resolver = std::make_shared<IntegerResolver>();
   detect::Checker gpu(gpu_backend(), resolver);
   detect::Checker cpu(detect::make_cpu_backend(2), resolver);
