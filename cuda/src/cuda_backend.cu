@@ -491,23 +491,6 @@ class CudaBackendImpl final : public CudaBackend {
     const auto& vertex_begin = topology_->layout.vertex_begin;
     const int32_t parts = static_cast<int32_t>(part_.size());
     const bool staged = staging_ && staging_->holds(positions);
-    // Set once a transfer out of a staging buffer is queued: its read event is then recorded
-    // on every way out, an exception's included (the frame, and with it the buffer, may be
-    // dropped at once, and the preparing thread write the buffer again).
-    bool read_queued = false;
-    struct NoteReadOnThrow {
-      PinnedStaging* staging;
-      std::span<const geom::Vec3d> positions;
-      cudaStream_t stream;
-      bool& armed;
-      ~NoteReadOnThrow() {
-        if (!armed) return;
-        try {
-          staging->note_read(positions, stream);
-        } catch (...) {  // the CUDA error already being thrown says more
-        }
-      }
-    } on_throw{staging_.get(), positions, s, read_queued};
     for (int32_t p = 0; p < parts;) {
       if (slot_version_[slot][p] == versions[p]) {
         ++p;
@@ -527,13 +510,11 @@ class CudaBackendImpl final : public CudaBackend {
         }
         SNAG_CUDA_CHECK(cudaMemcpyAsync(positions_[slot].data() + first, source,
                                         count * sizeof(geom::Vec3d), cudaMemcpyHostToDevice, s));
-        read_queued = staged;
+        // At once, transfer by transfer: should a later one fail, the frame (and with it the
+        // staging buffer) may be dropped, and the buffer is not written before this one is done.
+        if (staged) staging_->note_read(positions, s);
       }
       p = q;
-    }
-    if (read_queued) {
-      read_queued = false;
-      staging_->note_read(positions, s);
     }
   }
 

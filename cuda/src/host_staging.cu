@@ -9,7 +9,6 @@
 
 namespace snag::cuda {
 
-
 /// A frame's positions in one of the buffers, which comes back when this is dropped.
 class PinnedStaging::Staged final : public detect::StagedPositions {
  public:
