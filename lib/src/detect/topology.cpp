@@ -237,6 +237,10 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
   // is sized once: a first topology's time is mostly the first touch of its pages (on the
   // 2-core EPYC VM ~36 of a 36K cloth's ~41 ms, before the records were placed without a copy
   // and the edge lists sized ahead).
+  // A repeated corner: zero area in every frame, left out of the search, owns nothing.
+  auto repeats_a_corner = [](const geom::Tri& tri) {
+    return tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0];
+  };
   std::vector<int32_t> group_begin(static_cast<size_t>(vertex_count) + 1, 0);
   for (int32_t t = 0; t < n; ++t) {
     const geom::Tri& tri = triangles[t];
@@ -244,8 +248,7 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
       if (tri.v[k] < 0 || tri.v[k] >= vertex_count)
         throw InternalError("triangle " + std::to_string(t) + " uses vertex " +
                             std::to_string(tri.v[k]) + " of " + std::to_string(vertex_count));
-    if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0]) {
-      // A repeated corner: zero area in every frame, left out of the search, owns nothing.
+    if (repeats_a_corner(tri)) {
       topo.index_degenerate.push_back(t);
       continue;
     }
@@ -257,7 +260,7 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
     std::vector<int32_t> fill(group_begin.begin(), group_begin.end() - 1);
     for (int32_t t = 0; t < n; ++t) {
       const geom::Tri& tri = triangles[t];
-      if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[2] == tri.v[0]) continue;
+      if (repeats_a_corner(tri)) continue;
       for (int k = 0; k < 3; ++k) {
         const int32_t a = tri.v[k], b = tri.v[(k + 1) % 3];
         records[fill[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), t, k};
@@ -272,17 +275,19 @@ Topology make_scene_topology(std::span<const geom::Tri> triangles, int32_t verte
       records[to] = rec;
     }
 
+  // Whether record r is its edge's first (records of one edge are adjacent).
+  auto starts_edge = [&](size_t r) {
+    return r == 0 || records[r].u != records[r - 1].u || records[r].v != records[r - 1].v;
+  };
   size_t edge_count = 0;
-  for (size_t r = 0; r < records.size(); ++r)
-    edge_count += r == 0 || records[r].u != records[r - 1].u || records[r].v != records[r - 1].v;
+  for (size_t r = 0; r < records.size(); ++r) edge_count += starts_edge(r);
   topo.edges.reserve(edge_count);
   topo.edge_face_offsets.reserve(edge_count + 1);
   topo.edge_faces.reserve(records.size());
   topo.edge_face_offsets.push_back(0);
   for (size_t r = 0; r < records.size(); ++r) {
     const EdgeRecord& rec = records[r];
-    const bool new_edge = r == 0 || rec.u != records[r - 1].u || rec.v != records[r - 1].v;
-    if (new_edge) {
+    if (starts_edge(r)) {
       if (r > 0) topo.edge_face_offsets.push_back(static_cast<int32_t>(topo.edge_faces.size()));
       topo.edges.push_back({rec.u, rec.v});
       // Records of one edge are sorted by triangle: the first is the representative.
