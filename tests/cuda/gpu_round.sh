@@ -12,6 +12,25 @@ export SNAG_DATA_DIR=${SNAG_DATA_DIR:-$PWD/.gpu/extra/data}
 steps=("$@"); [ ${#steps[@]} -gt 0 ] || steps=(tests sanitize reports bench)
 summary=()
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+# alternate NAME TIMEOUT PATTERN ARGS...: `snag ARGS` of the binary staged as .gpu/base/snag
+# and of this build's, alternating, twice each, into $out/NAME_{base,new}{1,2}.txt; the lines
+# matching PATTERN are collected in $out/NAME_ab.txt. Nothing without a base binary.
+alternate() {
+  local name=$1 limit=$2 pattern=$3; shift 3
+  [ -x .gpu/base/snag ] || return 0
+  for r in 1 2; do
+    for v in base new; do
+      local bin=snag; [ $v = base ] && bin=.gpu/base/snag
+      timeout "$limit" $bin "$@" >"$out/${name}_$v$r.txt" 2>"$out/${name}_$v$r.err"
+      echo "== $v$r rc=$?" >>"$out/${name}_ab.txt"
+      grep -E "$pattern" "$out/${name}_$v$r.txt" >>"$out/${name}_ab.txt"
+    done
+  done
+}
+ab_summary() {
+  if [ -x .gpu/base/snag ]; then echo "base and new twice each: $out/$1_ab.txt"
+  else echo "skipped: no .gpu/base/snag"; fi
+}
 tests_rc=0
 for step in "${steps[@]}"; do
   t0=$(date +%s)
@@ -74,32 +93,14 @@ for step in "${steps[@]}"; do
     bench-ab)
       # The quick bench of the binary staged as .gpu/base/snag (an earlier commit's) and of this
       # build's, alternating, twice each: side by side in one lease, as A/B comparisons need.
-      [ -x .gpu/base/snag ] || { summary+=("bench-ab          skipped: no .gpu/base/snag"); continue; }
-      for r in 1 2; do
-        for v in base new; do
-          bin=snag; [ $v = base ] && bin=.gpu/base/snag
-          timeout 200 $bin bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 1 \
-            >"$out/bench_$v$r.txt" 2>"$out/bench_$v$r.err"
-          echo "== $v$r rc=$?" >>"$out/bench_ab.txt"
-          grep -E '^(cloth|n-body)' "$out/bench_$v$r.txt" >>"$out/bench_ab.txt"
-        done
-      done
-      summary+=("bench gpu (A/B)   base and new twice each: $out/bench_ab.txt")
+      alternate bench 200 '^(cloth|n-body)' bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 1
+      summary+=("bench gpu (A/B)   $(ab_summary bench)")
       ;;
     io-ab)
-      # snag bench io (IO_ARGS) of the binary staged as .gpu/base/snag and of this build's,
-      # alternating, twice each; the sequence tables' rows are collected.
-      [ -x .gpu/base/snag ] || { summary+=("io-ab             skipped: no .gpu/base/snag"); continue; }
-      for r in 1 2; do
-        for v in base new; do
-          bin=snag; [ $v = base ] && bin=.gpu/base/snag
-          # shellcheck disable=SC2086  # IO_ARGS is several arguments
-          timeout 300 $bin bench io --data "$SNAG_DATA_DIR" ${IO_ARGS:-} >"$out/io_$v$r.txt" 2>"$out/io_$v$r.err"
-          echo "== $v$r rc=$?" >>"$out/io_ab.txt"
-          grep -E '^(Sequence|cpu |cuda )' "$out/io_$v$r.txt" >>"$out/io_ab.txt"
-        done
-      done
-      summary+=("bench io (A/B)    base and new twice each: $out/io_ab.txt")
+      # snag bench io (IO_ARGS) the same way; the sequence tables' rows are collected.
+      # shellcheck disable=SC2086  # IO_ARGS is several arguments
+      alternate io 300 '^(Sequence|cpu |cuda )' bench io --data "$SNAG_DATA_DIR" ${IO_ARGS:-}
+      summary+=("bench io (A/B)    $(ab_summary io)")
       ;;
     bench-quick)
       snag bench gpu --data "$SNAG_DATA_DIR" --large 0 --frames 30 --cpu-frames 2 >"$out/bench_gpu.txt" 2>"$out/bench_gpu.err"; rc=$?
