@@ -679,9 +679,14 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
   try {
     while (current) {
       if (current->error) std::rethrow_exception(current->error);
-      // The frame after this one, when it is prepared already: a GPU copies its positions across
-      // while this one is checked. A frame that failed waits for its turn.
-      std::optional<PreparedFrame> following = handoff.take_if_ready();
+      // The frame after this one: a GPU copies its positions across and queues its checks
+      // while this one is checked. On a GPU it is waited for: when the preparing thread runs at
+      // about the checker's pace (frames with no pairs), a frame not quite ready would
+      // otherwise be checked with nothing queued behind it, and the next one's upload and
+      // launches would all come after. The CPU queues nothing ahead, so it takes the frame only
+      // when it is there. A frame that failed waits for its turn.
+      std::optional<PreparedFrame> following =
+          settings.gpu ? handoff.take() : handoff.take_if_ready();
       lap(times.waiting);
 
       const size_t i = current->frame->index;
