@@ -660,10 +660,12 @@ TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
 
   // One buffer: a frame's transfer queued from it (set_positions returns at once), the frame
   // given back and another staged over it at once, then the first frame checked. A big frame
-  // (60K vertices, a height field: no pairs), so that the transfer is still running when the
-  // second copy would start; the other frame stretched unevenly, so that its tree's quality
-  // and its candidate pairs differ (and so would any mixture of the two).
-  const SmallMesh big = grid_mesh(400, 150, [](int i, int j) {
+  // (a height field of 1M triangles: no pairs), whose builds queued ahead of the transfer keep
+  // the device busy long after the host has queued them. (At 120K the device kept pace with
+  // the host's queueing, and a staging without its wait for the transfer passed half the runs
+  // on an H200; at 1M it failed every round of five runs.) The other frame is stretched
+  // unevenly, so that its tree's quality differs (and so would any mixture of the two).
+  const SmallMesh big = grid_mesh(1000, 500, [](int i, int j) {
     return geom::Vec3d{double(i), double(j), double((i * j) % 5)};
   });
   SmallMesh moved = big;
@@ -677,11 +679,9 @@ TEST(CudaBackend, StagedPositionsGiveThePlainAnswers) {
     auto alone = gpu_backend();
     alone->set_topology(topology);
     const std::shared_ptr<detect::HostStaging> one = alone->host_staging(1);
-    // Builds queued first (nothing in build() waits for them: milliseconds of device work) hold
-    // the transfer back on the stream, so that the second copy below starts before the transfer
-    // does: without the staging's wait for it, the transfer reads the second frame. (A single
-    // build did not: it was done before the host had queued the transfer, and the transfer then
-    // kept ahead of the second copy, so that a staging without the wait passed.)
+    // Builds queued first (nothing in build() waits for them) hold the transfer back on the
+    // stream, so that the second copy below is done before the transfer starts: without the
+    // staging's wait for it, the transfer reads the second frame.
     alone->set_positions(moved.positions);
     for (int b = 0; b < 16; ++b) alone->build();
     std::shared_ptr<const detect::StagedPositions> first = one->stage(big.positions);
