@@ -333,8 +333,39 @@ TEST(ObjReader, ByteOrderMarkIsSkipped) {
   const mesh::Mesh m = read_obj("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj");
   ASSERT_EQ(m.positions.size(), 3u);
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
-  // Only at the very start: elsewhere it is a record snag does not know, passed over.
-  EXPECT_EQ(read_obj("v 0 0 0\n\xEF\xBB\xBFv 1 0 0\n", "t.obj").positions.size(), 1u);
+  // Only at the very start: elsewhere (files joined end to end) it would hide a vertex line.
+  expect_rejected("v 0 0 0\n\xEF\xBB\xBFv 1 0 0\n", 2, "byte 0xef");
+}
+
+// A line snag passes over must still look like OBJ (a keyword or '#'), so that a binary or
+// compressed file, or ascii numbers without a keyword, is not read as a mesh with nothing in it.
+TEST(ObjReader, RejectsLinesThatAreNoRecord) {
+  static const char kGzip[] = "\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03";
+  expect_rejected(std::string(kGzip, sizeof kGzip - 1), 1, "byte 0x1f");
+  static const char kNul[] = "v 0 0 0\n\0\0\0\n";
+  expect_rejected(std::string(kNul, sizeof kNul - 1), 2, "byte 0x00");
+  expect_rejected("ply\nformat ascii 1.0\nend_header\n0.5 0.25 1\n", 4,
+                  "'0.5' is not an OBJ record");
+  expect_rejected("v 0 0 0\n  -1 2 3\n", 2, "'-1'");
+}
+
+// "v0 0 0" is not a record snag skips: passed over, it would shift every later vertex index.
+TEST(ObjReader, RejectsAKeywordRunIntoItsNumbers) {
+  expect_rejected("v0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n", 1,
+                  "expected a blank after 'v', found 'v0'");
+  expect_rejected("v 0 0 0\nv-1 0 0\n", 2, "'v-1'");
+  expect_rejected("v 0 0 0\nv .5 0 0\nv.5 0 0\n", 3, "'v.5'");
+  expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf1 2 3\n", 4, "after 'f', found 'f1'");
+}
+
+// A lone CR anywhere in a line passed over (a file whose lines end with one reads as a single
+// comment line otherwise); CRLF is a line end.
+TEST(ObjReader, RejectsALoneCrInALinePassedOver) {
+  const InputError e = reject("# exported\rv 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r");
+  EXPECT_EQ(e.line(), 1) << e.what();
+  EXPECT_NE(std::string(e.what()).find("lone CR"), std::string::npos) << e.what();
+  expect_rejected("v 0 0 0\nvn 0 0 1\rvn 0 1 0\n", 2, "lone CR");
+  EXPECT_EQ(read_obj("# c\r\nvn 0 0 1\r\nv 0 0 0\r", "t.obj").positions.size(), 1u);
 }
 
 TEST(ObjReader, RejectsNanAndInf) {

@@ -6,6 +6,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <unordered_map>
@@ -52,18 +53,19 @@ class ObjParser {
         ++line_;
         continue;
       }
-      if (keyword_alone) {
-        if (c == 'v') {
-          parse_vertex();
-          skip_line();
-          if (tail_matches_cache()) return std::move(mesh_);
-          continue;
-        }
-        if (c == 'f') {
-          parse_face();
-        } else if (c == 'o' || c == 'g') {
-          parse_group();
-        }
+      if (keyword_alone && c == 'v') {
+        parse_vertex();
+        skip_line();
+        if (tail_matches_cache()) return std::move(mesh_);
+        continue;
+      }
+      if (keyword_alone && c == 'f') {
+        parse_face();
+      } else if (keyword_alone && (c == 'o' || c == 'g')) {
+        parse_group();
+      } else {
+        pass_over_line();
+        continue;
       }
       skip_line();
     }
@@ -117,6 +119,37 @@ class ObjParser {
       return false;
     cache_->apply(mesh_);
     return true;
+  }
+
+  /// Passes over a line snag does not read (a comment, or a record such as vt, vn, s, usemtl,
+  /// a simulator's own), which must still look like OBJ: a keyword's letter or '#' first, and no
+  /// lone CR. Otherwise a binary or compressed file, a file whose lines end with a lone CR (one
+  /// long comment), or "v0 0 0" (a vertex lost, every later index off by one) would check clean.
+  void pass_over_line() {
+    const char c = *p_;
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+    if (!letter && c != '#') {
+      const auto byte = static_cast<unsigned char>(c);
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02x", byte);
+      fail("a line starting with " +
+           (byte < 0x20 || byte >= 0x7f ? "byte " + std::string(hex) : quote_token(p_, end_)) +
+           " is not an OBJ record (a keyword or '#'); is this a binary or compressed file?");
+    }
+    if ((c == 'v' || c == 'f') && p_ + 1 < end_ &&
+        ((p_[1] >= '0' && p_[1] <= '9') || p_[1] == '-' || p_[1] == '+' || p_[1] == '.'))
+      fail("expected a blank after '" + std::string(1, c) + "', found " + quote_token(p_, end_));
+    const char* eol = detail::find_eol(p_, end_);
+    for (const char* cr = p_;
+         (cr = static_cast<const char*>(std::memchr(cr, '\r', static_cast<size_t>(eol - cr))));
+         ++cr)
+      if (cr + 1 < eol)
+        fail("a carriage return inside the line: are the file's lines ended by a lone CR?");
+    p_ = eol;
+    if (p_ < end_) {
+      ++p_;
+      ++line_;
+    }
   }
 
   void skip_line() {
