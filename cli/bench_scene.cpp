@@ -509,7 +509,7 @@ CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& o) {
       ->type_name("PATH");
   cmd->add_option("-j,--threads", o.threads, "CPU worker threads; 0 uses every core")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kThreadRange)
       ->capture_default_str();
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")

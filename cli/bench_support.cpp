@@ -13,6 +13,7 @@
 #include <random>
 
 #include "backend_factory.h"
+#include "commands.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/seq/sequence.h"
@@ -178,7 +179,7 @@ void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& da
       ->type_name("PATH");
   cmd->add_option("-j,--threads", *o.threads, "CPU worker threads; 0 uses every core")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kThreadRange)
       ->capture_default_str();
 }
 

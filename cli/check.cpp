@@ -233,7 +233,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
   cmd->add_option("-j,--threads", o.threads,
                   "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kThreadRange)
       ->capture_default_str();
   cmd->add_option("--fail-on", o.fail_on,
                   "Exit with status 1 when a frame has: crossing pairs, any pair, or none (never)")
@@ -258,6 +258,9 @@ int run_check(const CheckOptions& o) {
   if (!fail_on)
     throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
   if (o.weld && !(*o.weld >= 0)) throw UsageError("--weld: TOL must be a number >= 0");
+  // CLI11's range check lets NaN through (every comparison with it is false).
+  if (!(o.rebuild_threshold >= 1))
+    throw UsageError("--rebuild-threshold: FACTOR must be a number >= 1");
   const auto exact = detect::parse_exact_mode(o.exact);
   if (!exact) throw UsageError("--exact: expected off, uncertain or all, got '" + o.exact + "'");
 

@@ -11,6 +11,12 @@
 
 namespace snag::cli {
 
+/// The most threads --threads takes: far past any machine's cores, short of the thread counts
+/// that exhaust a process's stacks (-j 100000 crashed the run).
+inline constexpr int kMostThreads = 4096;
+/// --threads N: 0 (every core) to kMostThreads.
+inline const CLI::Range kThreadRange(0, kMostThreads);
+
 /// Options of `snag check`, filled by CLI11.
 struct CheckOptions {
   std::string sequence;

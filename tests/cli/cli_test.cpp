@@ -282,6 +282,9 @@ TEST(CliStatus, UsageErrorsExitTwo) {
       {"check", "seq", "--fail-on", "all"},
       {"check", "seq", "--backend", "gpu"},
       {"check", "seq", "--threads", "-1"},
+      {"check", "seq", "--threads", "100000"},  // crashed the run before it was capped
+      {"check", "seq", "--rebuild-threshold", "nan"},
+      {"check", "seq", "--rebuild-threshold", "0.5"},
       {"check", "seq", "--weld", "-0.5"},
       {"check", "seq", "--frames", "abc"},
       {"check", "seq", "--frames", "100-200"},

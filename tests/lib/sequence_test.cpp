@@ -77,6 +77,21 @@ TEST_F(SequenceDir, DirectoryWithoutFramesIsAnError) {
   EXPECT_THROW(resolve_sequence(dir_.string()), InputError);
 }
 
+// A frame whose link is broken (a cache on a volume not mounted, a render farm's link to a
+// file not written yet) is listed, so that reading it fails naming it; left out, the run would
+// check the other frames and pass. Links to files are followed as the files.
+TEST_F(SequenceDir, BrokenLinksAreListedAsFrames) {
+  touch({"a.0001.obj", "a.0002.obj"});
+  fs::create_symlink(dir_ / "a.0002.obj", dir_ / "a.0003.obj");
+  fs::create_symlink(dir_ / "missing.obj", dir_ / "a.0004.obj");
+  fs::create_symlink(dir_ / "missing.txt", dir_ / "notes.txt");  // not a frame's name
+  const Names expected = {
+      {1, "a.0001.obj"}, {2, "a.0002.obj"}, {3, "a.0003.obj"}, {4, "a.0004.obj"}};
+  EXPECT_EQ(names(resolve_sequence(dir_.string())), expected);
+  EXPECT_EQ(names(resolve_sequence(at("a.%04d.obj"))), expected);
+  EXPECT_EQ(names(resolve_sequence(at("a.*.obj"))), expected);
+}
+
 TEST_F(SequenceDir, PrintfPatternMatchesWhatPrintfWrites) {
   touch({"dress.0001.obj", "dress.0010.obj", "dress.12345.obj", "dress.001.obj", "dress.00002.obj",
          "dress.0003.ply", "body.0001.obj", "dress.-001.obj", "dress.00x1.obj"});

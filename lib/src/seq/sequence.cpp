@@ -174,7 +174,9 @@ bool glob_match(std::string_view pattern, std::string_view name) {
   return p == pattern.size();
 }
 
-/// Regular files (symlinks followed) directly in `dir`, by name.
+/// Regular files (symlinks followed) directly in `dir`, by name, and links to nothing: a
+/// frame whose link is broken is listed, so that reading it is the error that names it
+/// instead of a frame left out in silence.
 std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequence) {
   std::vector<fs::path> files;
   std::error_code ec;
@@ -183,7 +185,9 @@ std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequenc
     throw InputError(sequence, 0, "cannot list directory '" + dir.string() + "': " + ec.message());
   for (const fs::directory_entry& entry : it) {
     std::error_code type_ec;
-    if (entry.is_regular_file(type_ec))
+    std::error_code link_ec, target_ec;
+    const bool dangling = entry.is_symlink(link_ec) && !fs::exists(entry.path(), target_ec);
+    if (entry.is_regular_file(type_ec) || dangling)
       files.push_back(dir.empty() ? entry.path().filename() : entry.path());
   }
   return files;
