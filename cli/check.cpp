@@ -266,6 +266,16 @@ int run_check(const CheckOptions& o) {
 
   const scene::Scene scene = scene_of(o);
   const scene::ResolvedScene resolved = scene::resolve_scene(scene, o.frames);
+  if (!resolved.absent_frames.empty() && !o.quiet) {
+    // Not an error: a selection may reach past a cache on purpose. But a gate should not pass
+    // frames it never saw in silence.
+    std::string runs;
+    for (const std::string& run : resolved.absent_frames) runs += (runs.empty() ? "" : ", ") + run;
+    if (resolved.absent_frames.size() == scene::ResolvedScene::kMostAbsentRuns) runs += ", ...";
+    std::cerr << "snag: warning: --frames " << o.frames
+              << " names frames the sequence does not have (" << runs
+              << "); they are not checked\n";
+  }
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
   // once rather than after an hour of checking.

@@ -152,6 +152,31 @@ TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
   EXPECT_NE(r.err.find("[3/3] frame 3: clean"), std::string::npos) << r.err;
 }
 
+// --frames naming frames the sequence lacks (a cache with a frame missing, or cut short):
+// the frames there are checked, and a warning names the ones that are not; a broken link
+// among the frames is an input error naming it.
+TEST(CliCheck, FramesTheSequenceLacksAreNamed) {
+  TempDir tmp;
+  const fs::path seq = write_hand_built_sequence(tmp.path() / "seq");
+  fs::rename(seq / "f.0002.obj", seq / "f.0004.obj");  // frames 1, 3 and 4
+  const RunResult gap = run_snag({"check", "seq", "--frames", "1-6"}, tmp.path());
+  EXPECT_EQ(gap.status, 1) << context(gap);
+  EXPECT_NE(gap.err.find("--frames 1-6 names frames the sequence does not have (2, 5-6)"),
+            std::string::npos)
+      << gap.err;
+  EXPECT_NE(gap.out.find("frames checked       3"), std::string::npos) << gap.out;
+  const RunResult quiet = run_snag({"check", "seq", "--frames", "1-6", "-q"}, tmp.path());
+  EXPECT_EQ(quiet.err.find("warning"), std::string::npos) << quiet.err;
+  const RunResult whole = run_snag({"check", "seq", "--frames", "1-4"}, tmp.path());
+  EXPECT_NE(whole.err.find("does not have (2);"), std::string::npos) << whole.err;
+
+  fs::create_symlink(seq / "gone.obj", seq / "f.0005.obj");
+  const RunResult broken = run_snag({"check", "seq", "--out", "r"}, tmp.path());
+  EXPECT_EQ(broken.status, 3) << context(broken);
+  EXPECT_NE(broken.err.find("f.0005.obj: cannot open"), std::string::npos) << broken.err;
+  EXPECT_FALSE(fs::exists(tmp.path() / "r" / "pairs.csv"));
+}
+
 // A file without triangles checks clean, with a warning that says so: alone, as an obstacle
 // (whose empty tree has no pairs with the cloth) and as a cloth with an obstacle.
 TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -269,6 +272,70 @@ TEST(SelectFrames, SelectingNothingIsAUsageError) {
     EXPECT_NE(std::string(e.what()).find("'300-400' keeps none of the 2 frames (numbered 1 to 2)"),
               std::string::npos)
         << e.what();
+  }
+}
+
+TEST(AbsentRuns, NamesTheNumbersTheSequenceLacks) {
+  const std::vector<Frame> frames = {{1, "a"}, {2, "b"}, {4, "c"}, {5, "d"}, {9, "e"}};
+  using Runs = std::vector<std::string>;
+  EXPECT_EQ(FrameSelection().absent_runs(frames, 6), Runs{});
+  EXPECT_EQ(FrameSelection::parse("1-5").absent_runs(frames, 6), (Runs{"3"}));
+  EXPECT_EQ(FrameSelection::parse("1-2,4-5,9").absent_runs(frames, 6), Runs{});
+  EXPECT_EQ(FrameSelection::parse("0-12").absent_runs(frames, 6), (Runs{"0", "3", "6-8", "10-12"}));
+  EXPECT_EQ(FrameSelection::parse("1-13x4").absent_runs(frames, 6), (Runs{"13"}));
+  EXPECT_EQ(FrameSelection::parse("2-20x3").absent_runs(frames, 6), (Runs{"8-20x3"}));
+  EXPECT_EQ(FrameSelection::parse("100-200").absent_runs(frames, 6), (Runs{"100-200"}));
+  EXPECT_EQ(FrameSelection::parse("0-12").absent_runs(frames, 2), (Runs{"0", "3"}));
+  EXPECT_EQ(FrameSelection::parse("3,3").absent_runs(frames, 6), (Runs{"3"}));  // once
+  // Numbers at the ends of int64 do not overflow.
+  const int64_t most = std::numeric_limits<int64_t>::max();
+  const std::vector<Frame> far = {{most - 1, "x"}};
+  EXPECT_EQ(
+      FrameSelection::parse(std::to_string(most - 3) + "-" + std::to_string(most))
+          .absent_runs(far, 6),
+      (Runs{std::to_string(most - 3) + "-" + std::to_string(most - 2), std::to_string(most)}));
+}
+
+// absent_runs against enumerating every number each item names, on random sequences and
+// selections: the runs, expanded, are the numbers named and not present, item by item.
+TEST(AbsentRuns, AgreeWithEnumeratingEveryNumber) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<Frame> frames;
+    for (int64_t n = -5; n <= 40; ++n)
+      if (rng() % 3 != 0) frames.push_back({n, "f"});
+    std::string text;
+    const int items = 1 + static_cast<int>(rng() % 3);
+    for (int i = 0; i < items; ++i) {
+      const int64_t first = static_cast<int64_t>(rng() % 50) - 8;
+      const int64_t last = first + static_cast<int64_t>(rng() % 20);
+      const int64_t step = 1 + static_cast<int64_t>(rng() % 4);
+      text += (i ? "," : "") + std::to_string(first) + "-" + std::to_string(last) + "x" +
+              std::to_string(step);
+    }
+    SCOPED_TRACE(text);
+    const FrameSelection selection = FrameSelection::parse(text);
+    std::vector<int64_t> expected;  // item by item, each in order, a number once
+    for (size_t comma = 0, start = 0; start <= text.size(); start = comma + 1) {
+      comma = text.find(',', start);
+      if (comma == std::string::npos) comma = text.size();
+      const FrameSelection item = FrameSelection::parse(text.substr(start, comma - start));
+      for (int64_t n = -20; n <= 80; ++n) {
+        const bool present = std::any_of(frames.begin(), frames.end(),
+                                         [&](const Frame& f) { return f.number == n; });
+        if (item.contains(n) && !present &&
+            std::find(expected.begin(), expected.end(), n) == expected.end())
+          expected.push_back(n);
+      }
+    }
+    std::vector<int64_t> got;
+    for (const std::string& run : selection.absent_runs(frames, 1000)) {
+      const FrameSelection as_item = FrameSelection::parse(run);
+      for (int64_t n = -20; n <= 80; ++n)
+        if (as_item.contains(n) && std::find(got.begin(), got.end(), n) == got.end())
+          got.push_back(n);
+    }
+    EXPECT_EQ(got, expected);
   }
 }
 

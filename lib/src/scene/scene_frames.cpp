@@ -105,9 +105,11 @@ ResolvedScene resolve_scene(const Scene& scene, std::string_view frame_selection
   }
   const auto driver_index = static_cast<size_t>(driver - scene.objects.begin());
   resolved.frames = resolved.objects[driver_index].frames;
-  if (!frame_selection.empty())
-    resolved.frames =
-        seq::select_frames(resolved.frames, seq::FrameSelection::parse(frame_selection));
+  if (!frame_selection.empty()) {
+    const seq::FrameSelection selection = seq::FrameSelection::parse(frame_selection);
+    resolved.absent_frames = selection.absent_runs(resolved.frames, ResolvedScene::kMostAbsentRuns);
+    resolved.frames = seq::select_frames(resolved.frames, selection);
+  }
   for (size_t i = 0; i < resolved.objects.size(); ++i) {
     ResolvedObject& object = resolved.objects[i];
     if (i == driver_index) {

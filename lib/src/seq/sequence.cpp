@@ -340,6 +340,49 @@ bool FrameSelection::contains(int64_t frame) const {
   return false;
 }
 
+std::vector<std::string> FrameSelection::absent_runs(const std::vector<Frame>& frames,
+                                                     size_t most_runs) const {
+  std::vector<std::string> runs;
+  if (all_) return runs;
+  // A run of the item's numbers from `from` to `to` (both on its grid), when there is one.
+  const auto add_run = [&](int64_t from, int64_t to, int64_t step) {
+    if (from > to || runs.size() >= most_runs) return;
+    std::string run = std::to_string(from);
+    if (to != from) run += "-" + std::to_string(to);
+    if (to != from && step != 1) run += "x" + std::to_string(step);
+    if (std::find(runs.begin(), runs.end(), run) == runs.end()) runs.push_back(run);
+  };
+  for (const Range& r : ranges_) {
+    const auto step = static_cast<uint64_t>(r.step);
+    // The item's next number not yet accounted for; unsigned, as in contains(): the grid's
+    // numbers and their differences fit in 64 bits even where int64 sums would overflow.
+    uint64_t next = static_cast<uint64_t>(r.first);
+    bool done = false;
+    for (const Frame& f : frames) {
+      if (f.number < r.first) continue;
+      if (f.number > r.last) break;
+      const uint64_t offset = static_cast<uint64_t>(f.number) - static_cast<uint64_t>(r.first);
+      if (offset % step != 0) continue;
+      if (static_cast<uint64_t>(f.number) != next)
+        add_run(static_cast<int64_t>(next),
+                static_cast<int64_t>(static_cast<uint64_t>(f.number) - step), r.step);
+      if (static_cast<uint64_t>(r.last) - static_cast<uint64_t>(f.number) < step) {
+        // The item's last number: nothing after it.
+        done = true;
+        break;
+      }
+      next = static_cast<uint64_t>(f.number) + step;
+    }
+    if (!done) {
+      // The item's last number on its grid, from its first.
+      const uint64_t span = static_cast<uint64_t>(r.last) - static_cast<uint64_t>(r.first);
+      add_run(static_cast<int64_t>(next),
+              static_cast<int64_t>(static_cast<uint64_t>(r.first) + span / step * step), r.step);
+    }
+  }
+  return runs;
+}
+
 std::vector<Frame> select_frames(const std::vector<Frame>& frames,
                                  const FrameSelection& selection) {
   std::vector<Frame> kept;

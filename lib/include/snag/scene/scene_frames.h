@@ -28,6 +28,11 @@ struct ResolvedScene {
   std::vector<ResolvedObject> objects;
   /// The checked frames: the first cloth's, less those --frames leaves out.
   std::vector<seq::Frame> frames;
+  /// Numbers --frames names that the first cloth's sequence lacks, as runs
+  /// (seq::FrameSelection::absent_runs, at most kMostAbsentRuns): a cache cut short or with a
+  /// frame missing, which the user is told of.
+  std::vector<std::string> absent_frames;
+  static constexpr size_t kMostAbsentRuns = 6;
   /// The object pairs checked (a <= b; a == b: self), in increasing order.
   std::vector<detect::PartCheck> checks;
 };
