@@ -162,7 +162,7 @@ void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& da
                     "Generated cloth sizes in triangles (0 or an empty list: none)")
         ->type_name("T,...")
         ->delimiter(',')
-        ->check(CLI::NonNegativeNumber)
+        ->check(kNonNegative)
         ->capture_default_str();
   cmd->add_option("--data", *o.data_dir,
                   "The shared data folder; " + data_cases +

@@ -205,7 +205,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
                   "Vertices closer than TOL count as one for adjacency (reports keep the "
                   "file's ids)")
       ->type_name("TOL")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--rebuild", o.rebuild,
                   "When to rebuild the tree instead of refitting it: never, auto (when its "
                   "quality degrades past --rebuild-threshold), always")
@@ -228,7 +228,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->capture_default_str();
   cmd->add_option("--device", o.device, "CUDA device for the cuda backend, numbered from 0")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   cmd->add_option("-j,--threads", o.threads,
                   "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core")

@@ -17,6 +17,23 @@ inline constexpr int kMostThreads = 4096;
 /// --threads N: 0 (every core) to kMostThreads.
 inline const CLI::Range kThreadRange(0, kMostThreads);
 
+/// A number above `least` (`strictly`) or at least it, NaN refused: CLI11's PositiveNumber and
+/// NonNegativeNumber, whose messages print the largest double in full ("not in range 0.000000
+/// to 179769313486...").
+inline CLI::Validator number_above(double least, bool strictly, const std::string& description) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "expected a number, got '" + text + "'";
+        if (strictly ? value > least : value >= least) return {};
+        return "expected a number " + std::string(strictly ? "> " : ">= ") +
+               CLI::detail::to_string(least) + ", got '" + text + "'";
+      },
+      description);
+}
+inline const CLI::Validator kPositive = number_above(0, true, "POSITIVE");
+inline const CLI::Validator kNonNegative = number_above(0, false, "NONNEGATIVE");
+
 /// Options of `snag check`, filled by CLI11.
 struct CheckOptions {
   std::string sequence;
