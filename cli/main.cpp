@@ -77,6 +77,16 @@ int main(int argc, char** argv) {
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
         "3 input or output error, 4 internal error. See snag(1).");
 
+    // A first word that names no command: CLI11 would answer "A subcommand is required" (and
+    // `snag report --help` would print the top-level help and exit 0).
+    const auto names_a_command = [&](const std::string& word) {
+      for (const CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+        if (command->check_name(word)) return true;
+      return false;
+    };
+    if (argc > 1 && argv[1][0] != '-' && !names_a_command(argv[1]))
+      throw snag::UsageError("unknown command '" + std::string(argv[1]) +
+                             "'; expected check or bench");
     app.parse(argc, argv);
     if (check_command->parsed()) return snag::cli::run_check(check);
     if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);

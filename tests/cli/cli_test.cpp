@@ -324,6 +324,14 @@ TEST(CliStatus, UsageErrorsExitTwo) {
     EXPECT_EQ(r.status, 2) << "snag" << line << "\n" << context(r);
     EXPECT_FALSE(r.err.empty()) << "snag" << line << " says nothing";
   }
+  // A word that names no command is named (and its --help is no help that exits 0).
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"report"}, std::vector<std::string>{"report", "--help"}}) {
+    const RunResult r = run_snag(args, tmp.path());
+    EXPECT_EQ(r.status, 2) << context(r);
+    EXPECT_NE(r.err.find("unknown command 'report'; expected check or bench"), std::string::npos)
+        << r.err;
+  }
 }
 
 TEST(CliStatus, CudaBackendRunsOrExitsFourWithAReason) {
