@@ -465,9 +465,15 @@ TEST(PlyReader, AsciiRecordsAreOnePerLine) {
     const InputError e = reject(head + "0 0 0\n1 0 0\n0 1 0\n");
     expect_contains(e, "file ends before face 0 (of 1)");
   }
-  // Blank lines between records, blanks at their ends and no final line end are fine.
+  // Records after the last element's (a header counting too few faces): an error at the first.
+  expect_rejected_at("0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n3 2 1 0\n", 15,
+                     "'3' after the last element's records");
+  // Blank lines between records, blanks at their ends, blank lines after the last and no final
+  // line end are fine.
   const mesh::Mesh m = read_ply(head + "\n0 0 0 \n\n1 0 0\t\n0 1 0\n \n3 0 1 2", "t.ply");
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
+  EXPECT_EQ(tris(read_ply(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n \r\n", "t.ply")),
+            (Tris{{0, 1, 2}}));
   // An element without properties takes no line; one of one property names it so.
   const std::string vertices =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"

@@ -758,6 +758,16 @@ class AsciiBody {
       if (is_face) mesh_.polygon_count = el.count;
       if (is_vertex && reuse_.after_vertices(plan_, e, p_, end_, mesh_)) return std::move(mesh_);
     }
+    // Records after the last element's: a header whose counts are short (faces left unread
+    // would be intersections left unchecked). Blank lines are fine.
+    while (p_ < end_ && is_blank_or_eol(*p_)) {
+      if (*p_ == '\n') ++line_;
+      ++p_;
+    }
+    if (p_ != end_)
+      fail(quote_token(p_, end_) +
+           " after the last element's records; does the header count "
+           "every vertex and face?");
     reuse_.parsed_in_full(end_, mesh_);
     return std::move(mesh_);
   }
