@@ -2,10 +2,12 @@
 // standard output and, with --out, the reports.
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -166,6 +168,28 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
         << "{pairs.csv,frames.csv,report.json}\n";
 }
 
+/// A sequence whose frames are files of several kinds ('dress.*' matching dress.0003.obj.bak
+/// beside the .obj frames, read through assimp): each is a frame, which is rarely what was
+/// meant; said once, with the count of each kind.
+void warn_of_mixed_kinds(const scene::ResolvedScene& resolved, bool quiet) {
+  if (quiet) return;
+  for (const scene::ResolvedObject& object : resolved.objects) {
+    std::map<std::string, int> kinds;
+    for (const seq::Frame& f : object.frames) {
+      std::string kind = f.path.extension().string();
+      std::transform(kind.begin(), kind.end(), kind.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      ++kinds[kind.empty() ? "(none)" : kind];
+    }
+    if (kinds.size() < 2) continue;
+    std::string counts;
+    for (const auto& [kind, count] : kinds)
+      counts += (counts.empty() ? "" : ", ") + kind + ": " + std::to_string(count);
+    std::cerr << "snag: warning: " << object.spec.sequence << " matched files of several kinds ("
+              << counts << "); each is read as a frame\n";
+  }
+}
+
 }  // namespace
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
@@ -266,6 +290,7 @@ int run_check(const CheckOptions& o) {
 
   const scene::Scene scene = scene_of(o);
   const scene::ResolvedScene resolved = scene::resolve_scene(scene, o.frames);
+  warn_of_mixed_kinds(resolved, o.quiet);
   if (!resolved.absent_frames.empty() && !o.quiet) {
     // Not an error: a selection may reach past a cache on purpose. But a gate should not pass
     // frames it never saw in silence.

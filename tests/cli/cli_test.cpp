@@ -177,6 +177,20 @@ TEST(CliCheck, FramesTheSequenceLacksAreNamed) {
   EXPECT_FALSE(fs::exists(tmp.path() / "r" / "pairs.csv"));
 }
 
+// A glob that matches files of several kinds (a backup beside the frames) reads each as a
+// frame: a warning counts the kinds.
+TEST(CliCheck, GlobsMatchingSeveralKindsOfFileWarn) {
+  TempDir tmp;
+  const fs::path seq = write_hand_built_sequence(tmp.path() / "seq");
+  fs::copy_file(seq / "f.0003.obj", seq / "f.0004.obj.bak");
+  const RunResult mixed = run_snag({"check", "seq/f.*"}, tmp.path());
+  EXPECT_NE(mixed.err.find("seq/f.* matched files of several kinds (.bak: 1, .obj: 3)"),
+            std::string::npos)
+      << context(mixed);
+  const RunResult plain = run_snag({"check", "seq/f.*.obj"}, tmp.path());
+  EXPECT_EQ(plain.err.find("several kinds"), std::string::npos) << plain.err;
+}
+
 // A file without triangles checks clean, with a warning that says so: alone, as an obstacle
 // (whose empty tree has no pairs with the cloth) and as a cloth with an obstacle.
 TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {
