@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
       "snag"};
   try {
     app.set_version_flag("--version", SNAG_VERSION);
+    // CLI11's own messages (a bad value, an unknown option) start as snag's do; set before the
+    // subcommands are added, which copy it.
+    app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
+      return "snag: error: " + CLI::FailureMessage::simple(failed, e);
+    });
     app.require_subcommand(1, 1);
     snag::cli::CheckOptions check;
     CLI::App* check_command = snag::cli::add_check_command(app, check);

@@ -337,6 +337,7 @@ TEST(CliStatus, UsageErrorsExitTwo) {
     const RunResult r = run_snag(args, tmp.path());
     EXPECT_EQ(r.status, 2) << "snag" << line << "\n" << context(r);
     EXPECT_FALSE(r.err.empty()) << "snag" << line << " says nothing";
+    EXPECT_EQ(r.err.rfind("snag: error: ", 0), 0u) << "snag" << line << ": " << r.err;
   }
   // A word that names no command is named (and its --help is no help that exits 0).
   for (const std::vector<std::string>& args :
