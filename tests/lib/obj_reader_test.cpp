@@ -288,6 +288,7 @@ TEST(ObjReader, RejectsIndexOutOfRange) {
   expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4/1/1\nv 0 0 1\nf 1 2 9\n", 7, "'9'");
   expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", 4, "'-4'");
   expect_rejected("v 0 0 0\nf 1 2 99999999999999999999\n", 2, "out of range");
+  expect_rejected("f 1 2 3\n", 1, "'1' is out of range; the file has no vertex line");
 }
 
 TEST(ObjReader, RejectsNonNumbers) {

@@ -342,10 +342,12 @@ class ObjParser {
     const auto count = static_cast<int64_t>(mesh_.positions.size());
     for (const ForwardReference& ref : forward_) {
       if (ref.index > count) {
+        const std::string expected =
+            count == 0 ? "the file has no vertex line"
+                       : "the file has " + std::to_string(count) + " vertices (expected 1.." +
+                             std::to_string(count) + " or -1..-" + std::to_string(count) + ")";
         throw InputError(name_, ref.line,
-                         "vertex index '" + ref.token + "' is out of range; the file has " +
-                             std::to_string(count) + " vertices (expected 1.." +
-                             std::to_string(count) + " or -1..-" + std::to_string(count) + ")");
+                         "vertex index '" + ref.token + "' is out of range; " + expected);
       }
     }
   }
