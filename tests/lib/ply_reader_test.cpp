@@ -601,6 +601,9 @@ TEST(PlyReader, RejectsMalformedHeaders) {
       {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float\n", 4,
        "expected 'property <type> <name>'"},
       {"ply\nformat ascii 1.0\nvertices 3\n", 3, "unknown header line 'vertices 3'"},
+      // Cut short inside a header line: not an unknown line "pr", nor a count "1" of "12".
+      {"ply\nformat ascii 1.0\nelement vertex 3\npr", 4, "file ends inside the PLY header"},
+      {"ply\nformat ascii 1.0\nelement vertex 1", 3, "file ends inside the PLY header"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
@@ -608,6 +611,15 @@ TEST(PlyReader, RejectsMalformedHeaders) {
     EXPECT_EQ(e.line(), c.line) << e.what();
     expect_contains(e, c.message);
   }
+}
+
+// end_header as the file's last bytes, with no line end: a header whole, its elements empty.
+TEST(PlyReader, EndHeaderMayEndTheFile) {
+  const mesh::Mesh m = read_ply(
+      "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header",
+      "t.ply");
+  EXPECT_TRUE(m.positions.empty());
 }
 
 TEST(PlyReader, RejectsMissingVertexOrFaceData) {

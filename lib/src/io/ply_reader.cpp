@@ -167,10 +167,15 @@ Header parse_header(std::string_view bytes, const std::string& name) {
     }
     ++line;
     size_t nl = bytes.find('\n', pos);
-    if (nl == std::string_view::npos) nl = bytes.size();
+    const bool last_line = nl == std::string_view::npos;
+    if (last_line) nl = bytes.size();
     std::string_view text = bytes.substr(pos, nl - pos);
     pos = nl + 1;
     split_words(text, words);
+    // A header line the file ends inside (no line end after it) is cut short, whatever its
+    // words: "pr" of "property" is not an unknown keyword.
+    if (last_line && line > 1 && !(words.size() == 1 && words[0] == "end_header"))
+      fail("file ends inside the PLY header; expected an 'end_header' line");
     if (line == 1) {
       if (words.size() != 1 || words[0] != "ply") {
         fail("expected 'ply' on the first line, found " +
