@@ -394,6 +394,23 @@ TEST(PlyReader, BinaryHeaderWithCrlfStartsBodyAfterTheNewline) {
   EXPECT_EQ(tris(m), (Tris{{0, 1, 2}}));
 }
 
+// Bytes after the last element's records (a header counting too few faces, or data appended):
+// an error at the first of them, in both byte orders; the faces would otherwise go unread.
+TEST(PlyReader, RejectsBytesAfterTheLastBinaryRecord) {
+  for (const Enc enc : {Enc::le, Enc::be}) {
+    const std::string full = square(enc);
+    const InputError e = reject(full + "garbage");
+    expect_contains(e, "7 bytes after the last element's records");
+    EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(full.size()));
+    // Two faces declared as one: the second face's 13 bytes are left over.
+    std::string short_count = full;
+    const size_t count = short_count.find("element face 2");
+    ASSERT_NE(count, std::string::npos);
+    short_count[count + 13] = '1';
+    expect_contains(reject(short_count), "13 bytes after the last element's records");
+  }
+}
+
 TEST(PlyReader, RejectsTruncatedBinary) {
   const std::string full = square(Enc::be);
   const size_t body = full.find("end_header\n") + 11;
@@ -601,6 +618,8 @@ TEST(PlyReader, RejectsMalformedHeaders) {
       {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float\n", 4,
        "expected 'property <type> <name>'"},
       {"ply\nformat ascii 1.0\nvertices 3\n", 3, "unknown header line 'vertices 3'"},
+      {"ply\nformat ascii 1.0\n" + elements + "end_header 0 0 0\n", 9,
+       "expected 'end_header' alone on its line"},
       // Cut short inside a header line: not an unknown line "pr", nor a count "1" of "12".
       {"ply\nformat ascii 1.0\nelement vertex 3\npr", 4, "file ends inside the PLY header"},
       {"ply\nformat ascii 1.0\nelement vertex 1", 3, "file ends inside the PLY header"},

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_set>
 #include <vector>
 
 #include "file_buffer.h"
@@ -159,6 +160,7 @@ Header parse_header(std::string_view bytes, const std::string& name) {
   size_t pos = 0;
   int64_t line = 0;
   bool have_format = false;
+  std::unordered_set<std::string> element_property_names;  // the last element's, so far
   auto fail = [&](const std::string& what) -> void { throw InputError(name, line, what); };
   for (;;) {
     if (pos >= bytes.size()) {
@@ -187,6 +189,7 @@ Header parse_header(std::string_view bytes, const std::string& name) {
     const std::string_view key = words[0];
     if (key == "comment" || key == "obj_info") continue;
     if (key == "end_header") {
+      if (words.size() != 1) fail("expected 'end_header' alone on its line, found " + quote(text));
       if (!have_format)
         fail(
             "header has no 'format' line; expected 'format "
@@ -221,6 +224,7 @@ Header parse_header(std::string_view bytes, const std::string& name) {
              "; expected a non-negative integer");
       }
       h.elements.push_back(std::move(e));
+      element_property_names.clear();
     } else if (key == "property") {
       if (h.elements.empty()) fail("property before any element: " + quote(text));
       Property p;
@@ -251,11 +255,10 @@ Header parse_header(std::string_view bytes, const std::string& name) {
         }
         p.name = std::string(words[2]);
       }
-      for (const Property& earlier : h.elements.back().properties)
-        if (earlier.name == p.name) {
-          fail("property " + quote(p.name) + " of element " + quote(h.elements.back().name) +
-               " is declared twice");
-        }
+      // A set, not a scan of the earlier ones: a header of 80,000 properties took 35 s.
+      if (!element_property_names.insert(p.name).second)
+        fail("property " + quote(p.name) + " of element " + quote(h.elements.back().name) +
+             " is declared twice");
       h.elements.back().properties.push_back(std::move(p));
     } else {
       fail("unknown header line " + quote(text.substr(0, 60)) +
@@ -410,6 +413,14 @@ class BinaryBody {
         skip_element(el);
       }
     }
+    // Bytes after the last element's records: a header whose counts are short (faces left
+    // unread would be intersections left unchecked).
+    if (p_ != end_)
+      throw InputError(name_, 0,
+                       std::to_string(end_ - p_) +
+                           " bytes after the last element's records; does the header count "
+                           "every vertex and face?",
+                       offset(p_));
     reuse_.parsed_in_full(end_, mesh_);
     return std::move(mesh_);
   }
