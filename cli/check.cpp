@@ -2,10 +2,10 @@
 // standard output and, with --out, the reports.
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -171,22 +171,20 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
 /// A sequence whose frames are files of several kinds ('dress.*' matching dress.0003.obj.bak
 /// beside the .obj frames, read through assimp): each is a frame, which is rarely what was
 /// meant; said once, with the count of each kind.
-void warn_of_mixed_kinds(const scene::ResolvedScene& resolved, bool quiet) {
-  if (quiet) return;
+void warn_of_mixed_kinds(const scene::ResolvedScene& resolved,
+                         const std::function<void(const std::string&)>& warn) {
   for (const scene::ResolvedObject& object : resolved.objects) {
     std::map<std::string, int> kinds;
     for (const seq::Frame& f : object.frames) {
-      std::string kind = f.path.extension().string();
-      std::transform(kind.begin(), kind.end(), kind.begin(),
-                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      const std::string kind = io::lowercase_extension(f.path);
       ++kinds[kind.empty() ? "(none)" : kind];
     }
     if (kinds.size() < 2) continue;
     std::string counts;
     for (const auto& [kind, count] : kinds)
       counts += (counts.empty() ? "" : ", ") + kind + ": " + std::to_string(count);
-    std::cerr << "snag: warning: " << object.spec.sequence << " matched files of several kinds ("
-              << counts << "); each is read as a frame\n";
+    warn(object.spec.sequence + " matched files of several kinds (" + counts +
+         "); each is read as a frame");
   }
 }
 
@@ -290,16 +288,19 @@ int run_check(const CheckOptions& o) {
 
   const scene::Scene scene = scene_of(o);
   const scene::ResolvedScene resolved = scene::resolve_scene(scene, o.frames);
-  warn_of_mixed_kinds(resolved, o.quiet);
-  if (!resolved.absent_frames.empty() && !o.quiet) {
+  Progress progress(static_cast<int64_t>(resolved.frames.size()), o.quiet);
+  const auto warn = [&](const std::string& warning) {
+    if (!o.quiet) progress.message("snag: warning: " + warning);
+  };
+  warn_of_mixed_kinds(resolved, warn);
+  if (!resolved.absent_frames.empty()) {
     // Not an error: a selection may reach past a cache on purpose. But a gate should not pass
     // frames it never saw in silence.
     std::string runs;
     for (const std::string& run : resolved.absent_frames) runs += (runs.empty() ? "" : ", ") + run;
     if (resolved.absent_frames.size() == scene::ResolvedScene::kMostAbsentRuns) runs += ", ...";
-    std::cerr << "snag: warning: --frames " << o.frames
-              << " names frames the sequence does not have (" << runs
-              << "); they are not checked\n";
+    warn("--frames " + o.frames + " names frames the sequence does not have (" + runs +
+         "); they are not checked");
   }
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
@@ -345,7 +346,6 @@ int run_check(const CheckOptions& o) {
   report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings),
                                inputs.objects, threads);
 
-  Progress progress(static_cast<int64_t>(resolved.frames.size()), o.quiet);
   SequenceSettings sequence;
   sequence.weld = o.weld;
   sequence.threads = threads;
@@ -356,9 +356,7 @@ int run_check(const CheckOptions& o) {
         progress.update(reports.summary().frames_checked + 1, frame_note(record));
         reports.add(std::move(record));
       },
-      [&](const std::string& warning) {
-        if (!o.quiet) progress.message("snag: warning: " + warning);
-      });
+      warn);
   progress.finish();
 
   RunTotals totals;

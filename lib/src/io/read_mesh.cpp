@@ -17,13 +17,13 @@
 #include "structure_cache.h"
 
 namespace snag::io {
-namespace {
-
 std::string lowercase_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
   return ext;
 }
+
+namespace {
 
 class OpenFile {
  public:

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "snag/error.h"
+#include "snag/io/read_mesh.h"
 
 namespace snag::seq {
 namespace fs = std::filesystem;
@@ -18,13 +19,8 @@ bool is_digit(char c) {
   return c >= '0' && c <= '9';
 }
 
-char lower(char c) {
-  return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
-}
-
 bool is_frame_file_extension(const fs::path& p) {
-  std::string ext = p.extension().string();
-  for (char& c : ext) c = lower(c);
+  const std::string ext = io::lowercase_extension(p);
   return ext == ".obj" || ext == ".ply";
 }
 

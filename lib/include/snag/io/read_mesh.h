@@ -43,6 +43,10 @@ class FrameReader {
   std::unique_ptr<detail::StructureCache> cache_;
 };
 
+/// The file name's extension with ASCII letters lowered (".OBJ" -> ".obj"; "" when none): what
+/// picks a frame file's reader, and what a sequence's kinds of file are told apart by.
+std::string lowercase_extension(const std::filesystem::path& path);
+
 /// The whole file in one read (the readers parse from memory). Throws snag::InputError when the
 /// file cannot be opened or read.
 std::string read_file_bytes(const std::filesystem::path& path);
