@@ -776,10 +776,7 @@ class AsciiBody {
     }
     // Records after the last element's: a header whose counts are short (faces left unread
     // would be intersections left unchecked). Blank lines are fine.
-    while (p_ < end_ && is_blank_or_eol(*p_)) {
-      if (*p_ == '\n') ++line_;
-      ++p_;
-    }
+    skip_blank_lines();
     if (p_ != end_)
       fail(quote_token(p_, end_) +
            " after the last element's records; does the header count "
@@ -797,12 +794,17 @@ class AsciiBody {
   /// Moves to the line of record i: past the line end after the record before and any blank
   /// lines, counting them; fails at the end of the file.
   void begin_record(const Element& el, int64_t i) {
+    skip_blank_lines();
+    if (p_ == end_) [[unlikely]]
+      fail_before_record(el, i);
+  }
+
+  /// Past blanks and line ends, counting the lines.
+  void skip_blank_lines() {
     while (p_ < end_ && is_blank_or_eol(*p_)) {
       if (*p_ == '\n') ++line_;
       ++p_;
     }
-    if (p_ == end_) [[unlikely]]
-      fail_before_record(el, i);
   }
 
   /// Past the blanks after record i's last value; fails unless its line ends there.

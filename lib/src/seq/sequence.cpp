@@ -180,10 +180,9 @@ std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequenc
   if (ec)
     throw InputError(sequence, 0, "cannot list directory '" + dir.string() + "': " + ec.message());
   for (const fs::directory_entry& entry : it) {
-    std::error_code type_ec;
-    std::error_code link_ec, target_ec;
-    const bool dangling = entry.is_symlink(link_ec) && !fs::exists(entry.path(), target_ec);
-    if (entry.is_regular_file(type_ec) || dangling)
+    std::error_code ignored;  // an entry whose type cannot be told is not listed
+    const bool dangling = entry.is_symlink(ignored) && !fs::exists(entry.path(), ignored);
+    if (entry.is_regular_file(ignored) || dangling)
       files.push_back(dir.empty() ? entry.path().filename() : entry.path());
   }
   return files;
