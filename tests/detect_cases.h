@@ -185,6 +185,25 @@ inline SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
   return soup;
 }
 
+/// Collapses every `every`-th triangle of a soup whose triangles have three vertices of their own
+/// (random_soup), from `first` on: in turn all three corners onto `pile`, one point shared by all
+/// of them, and the second corner onto the first. Zero-area triangles whose leaves get the empty
+/// box (bvh::leaf_box). Returns their ids in order.
+inline std::vector<int32_t> collapse_soup_triangles(SmallMesh& soup, int32_t every, int32_t first,
+                                                    geom::Vec3d pile) {
+  std::vector<int32_t> collapsed;
+  const auto n = static_cast<int32_t>(soup.triangles.size());
+  for (int32_t t = first; t < n; t += every) {
+    const geom::Tri tri = soup.triangles[t];
+    if (collapsed.size() % 2 == 0)
+      for (int k = 0; k < 3; ++k) soup.positions[tri.v[k]] = pile;
+    else
+      soup.positions[tri.v[1]] = soup.positions[tri.v[0]];
+    collapsed.push_back(t);
+  }
+  return collapsed;
+}
+
 /// A grid of w x h cells, vertex (i, j) at `at(i, j)`, each cell split along the diagonal
 /// from (i, j) to (i + 1, j + 1): an interior vertex has 6 triangles, an edge along i or j
 /// has 2.
@@ -208,6 +227,25 @@ inline SmallMesh folded_grid(int w, int h) {
     const int fold = (i * 3) % (2 * w);  // zig-zag in x: the sheet passes through itself
     return geom::Vec3d{double(fold < w ? fold : 2 * w - fold), double(j * 2), double((i * i) % 7)};
   });
+}
+
+/// folded_grid(12, 8) with `piled` triangles of three vertices of their own after its own, all
+/// at one point: in turn its vertex 40 (a corner of six of its triangles) and a point inside one
+/// of its faces. A zeroed or collapsed region in a frame of a real cache, whose triangles are
+/// listed as degenerate and pair with nothing. Their ids are the last `piled`.
+inline SmallMesh folded_grid_with_piles(int32_t piled) {
+  SmallMesh mesh = folded_grid(12, 8);
+  const geom::Tri face = mesh.triangles[17];
+  const geom::Vec3d inside = mesh.positions[face.v[0]] + mesh.positions[face.v[1]] +
+                             mesh.positions[face.v[2]];  // scaled by 3 with the sheet below
+  for (auto& p : mesh.positions) p = 3.0 * p;
+  const geom::Vec3d piles[2] = {mesh.positions[40], inside};
+  for (int32_t i = 0; i < piled; ++i) {
+    const auto first = static_cast<int32_t>(mesh.positions.size());
+    for (int k = 0; k < 3; ++k) mesh.positions.push_back(piles[i % 2]);
+    mesh.triangles.push_back({{first, first + 1, first + 2}});
+  }
+  return mesh;
 }
 
 }  // namespace snag::test

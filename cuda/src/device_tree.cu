@@ -134,7 +134,7 @@ __device__ __forceinline__ geom::Box3f fit_leaf(const LeafCorners& leaf,
                                                 geom::PlaneCoefficients* planes) {
   planes[leaf.triangle] =
       geom::PlaneCoefficients::of(leaf.corner[0], leaf.corner[1], leaf.corner[2]);
-  return geom::triangle_box(leaf.corner[0], leaf.corner[1], leaf.corner[2]);
+  return bvh::leaf_box(leaf.corner[0], leaf.corner[1], leaf.corner[2]);
 }
 
 __device__ __forceinline__ geom::Box3f fit_leaf_and_plane(const bvh::TreeView& tree,
@@ -166,7 +166,7 @@ __global__ void refit_level_kernel(bvh::TreeView tree, int32_t first, int32_t la
 /// shared memory behind the block's one barrier, and the first warp fits the levels up to
 /// `top`. The last block to finish (a ticket, as the quality's) fits the levels above `top`
 /// from the blocks' roots. Each box is geom::merge of the same two children or the
-/// geom::triangle_box of its corners (bvh::leaf_box), so the CPU's bits.
+/// bvh::leaf_box of its corners, so the CPU's bits.
 /// It replaced, in turn, a climb (one thread per leaf going up while it was the second child to
 /// arrive, an atomic and a fence per level: 16 dependent steps through L2 at 36K, 22.5 us) and
 /// blocks of 512 threads per subtree with a block barrier per level and boxes stored a float at

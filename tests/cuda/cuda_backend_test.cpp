@@ -105,6 +105,8 @@ TEST(CudaTree, SameTreeAsTheCpuForManySizes) {
         p = {std::round(p.x), std::round(p.y * 2) / 2, std::round(p.z)};
     if (n % 5 == 0)
       for (auto& p : soup.positions) p.x = -p.x;  // negative coordinates, -0 among them
+    if (n % 7 == 0)  // collapsed triangles, whose leaves get the empty box
+      collapse_soup_triangles(soup, 4, 1, {5.0, 5.0, 5.0});
     const mesh::MeshView view = mesh::view_of(soup.positions, soup.triangles);
     bvh::Tree cpu_tree;
     cpu_tree.build(view, 2);
@@ -147,6 +149,8 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
       std::uniform_real_distribution<double> move(-2.0, 2.0);
       for (int frame = 0; frame < 3; ++frame) {
         for (auto& p : moved.positions) p = p + geom::Vec3d{move(rng), move(rng), move(rng)};
+        // Frame 1 collapses some triangles (empty leaf boxes); frame 2 moves them apart again.
+        if (frame == 1) collapse_soup_triangles(moved, 3, frame, {1.0, 2.0, 3.0});
         bvh::Tree cpu_copy = cpu_tree;
         cpu_copy.refit(mesh::view_of(moved.positions, moved.triangles), 2);
         gpu->set_positions(moved.positions);
@@ -300,6 +304,36 @@ TEST(CudaDetect, DegenerateFacesComeAndGoBetweenFrames) {
     if (frame % 2 == 1) EXPECT_FALSE(c.scan.degenerate.empty());
     expect_same(c, g, "frame " + std::to_string(frame));
     EXPECT_EQ(check_on_gpu(moved).pairs, brute_force(moved)) << "frame " << frame;
+  }
+}
+
+TEST(CudaDetect, PilesOfCollapsedTrianglesAndAZeroedFrameMatchTheCpu) {
+  SNAG_REQUIRE_GPU();
+  // Collapsed triangles' leaves have empty boxes on both backends (bvh::leaf_box): the same
+  // degenerate lists, qualities, candidates and pairs as the CPU, and brute force's pairs.
+  const SmallMesh piles = folded_grid_with_piles(500);
+  expect_same_filtered(piles, "piles");
+  EXPECT_EQ(check_on_gpu(piles).pairs, brute_force(piles));
+  // A sequence with a frame whose positions were all zeroed, between two of the sheet.
+  const SmallMesh mesh = folded_grid(12, 8);
+  const detect::Topology topology =
+      detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  auto cpu = detect::make_cpu_backend(2);
+  auto gpu = gpu_backend();
+  cpu->set_topology(topology);
+  gpu->set_topology(topology);
+  SmallMesh zeroed = mesh;
+  for (auto& p : zeroed.positions) p = {0.0, 0.0, 0.0};
+  for (int frame = 0; frame < 3; ++frame) {
+    const SmallMesh& at = frame == 1 ? zeroed : mesh;
+    const Filtered c = filtered(*cpu, at.positions, frame == 0);
+    const Filtered g = filtered(*gpu, at.positions, frame == 0);
+    expect_same(c, g, "frame " + std::to_string(frame));
+    if (frame == 1) {
+      EXPECT_EQ(c.scan.degenerate.size(), mesh.triangles.size());
+      EXPECT_EQ(g.frame.candidate_pairs, 0);
+      EXPECT_EQ(g.quality, 0.0);
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -91,6 +92,24 @@ TEST(Box, TriangleBoxContainsItsCornersExactly) {
   EXPECT_EQ(box.lo[0], reference_down(-0.0));
   EXPECT_EQ(box.hi[2], std::numeric_limits<float>::infinity());
   EXPECT_EQ(box.lo[2], reference_down(-0.7));
+}
+
+TEST(Box, AnEmptyBoxOverlapsNoFiniteBoxHasNoAreaAndLeavesMergesAlone) {
+  const Box3f empty = empty_box();
+  const Box3f point = triangle_box({1, 2, 3}, {1, 2, 3}, {1, 2, 3});
+  const Box3f wide = triangle_box({-1e30, -1e30, -1e30}, {1e30, 1e30, 1e30}, {0, 0, 0});
+  for (const Box3f& box : {point, wide, empty}) {
+    EXPECT_FALSE(overlap(empty, box));
+    EXPECT_FALSE(overlap(box, empty));
+    EXPECT_TRUE(contains(box, empty));
+  }
+  EXPECT_EQ(half_area(empty), 0.0);
+  EXPECT_EQ(half_area(merge(empty, empty)), 0.0);
+  EXPECT_EQ(half_area(point), 0.0);
+  const Box3f merged = merge(empty, wide);
+  EXPECT_EQ(std::memcmp(&merged, &wide, sizeof wide), 0);
+  EXPECT_EQ(half_area(merged), half_area(wide));
+  EXPECT_GT(half_area(wide), 0.0);
 }
 
 }  // namespace

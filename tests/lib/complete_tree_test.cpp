@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -461,6 +462,108 @@ TEST(Traversal, GroupedWalkVisitsTheSamePairsAsThePerLeafOne) {
       ASSERT_EQ(grouped_pairs<4>(view), per_leaf);
       ASSERT_EQ(grouped_pairs<8>(view), per_leaf);
     }
+  }
+}
+
+/// The pairs of triangles whose corner boxes (geom::triangle_box) overlap, both not in `left_out`.
+PairMultiset overlapping_box_pairs(const Soup& soup, const std::vector<uint8_t>& left_out) {
+  auto box = [&](int32_t t) {
+    const geom::Tri tri = soup.triangles[t];
+    return geom::triangle_box(soup.positions[tri.v[0]], soup.positions[tri.v[1]],
+                              soup.positions[tri.v[2]]);
+  };
+  PairMultiset pairs;
+  const auto n = static_cast<int32_t>(soup.triangles.size());
+  for (int32_t a = 0; a < n; ++a)
+    for (int32_t b = a + 1; b < n; ++b)
+      if (!left_out[a] && !left_out[b] && geom::overlap(box(a), box(b))) pairs.insert({a, b});
+  return pairs;
+}
+
+/// The leaf boxes of a search tree: empty for the collapsed triangles, every other one holding
+/// its corners; and every box holding its children.
+void expect_search_boxes(const Tree& tree, const Soup& soup,
+                         const std::vector<uint8_t>& collapsed) {
+  const CompleteTree& shape = tree.shape();
+  const geom::Box3f empty = geom::empty_box();
+  for (int32_t node = 0; node < shape.leaf_count - 1; ++node) {
+    ASSERT_TRUE(geom::contains(tree.boxes()[node], tree.boxes()[2 * node + 1])) << node;
+    ASSERT_TRUE(geom::contains(tree.boxes()[node], tree.boxes()[2 * node + 2])) << node;
+  }
+  for (int32_t p = 0; p < shape.leaf_count; ++p) {
+    const int32_t t = tree.triangle_at()[p];
+    const geom::Box3f& box = tree.boxes()[shape.leaf_at(p)];
+    const geom::Tri tri = soup.triangles[t];
+    const geom::Box3f corners = geom::triangle_box(
+        soup.positions[tri.v[0]], soup.positions[tri.v[1]], soup.positions[tri.v[2]]);
+    const geom::Box3f& expected = collapsed[t] ? empty : corners;
+    ASSERT_EQ(std::memcmp(&box, &expected, sizeof box), 0) << "triangle " << t;
+  }
+}
+
+TEST(Tree, CollapsedTrianglesGetEmptyBoxesAndNoWalkReachesThem) {
+  // A pile of triangles collapsed to one point (a zeroed frame, a region gone to a point) made
+  // every walk reach all of them: quadratic. Their leaves now get the empty box, so the walks,
+  // grouped or split as the backends run them, visit exactly the other overlapping pairs; a
+  // distance tree (LeafBoxes::every_triangle) keeps their boxes.
+  for (int32_t n : {1, 2, 3, 9, 50, 513, 2000}) {
+    for (double size : {0.2, 1.0}) {
+      const uint32_t seed = static_cast<uint32_t>(n * 13 + size * 5);
+      SCOPED_TRACE(soup_case(n, size, seed));
+      Soup soup = random_soup(n, seed, size);
+      std::vector<uint8_t> collapsed(static_cast<size_t>(n), 0), none(collapsed);
+      // One in three: with n = 1 the only triangle, with 2000 a pile of over 300 at one point.
+      for (int32_t t : test::collapse_soup_triangles(soup, 3, 0, {5.0, 5.0, 5.0})) collapsed[t] = 1;
+      Tree search, distance(LeafBoxes::every_triangle);
+      search.build(soup_view(soup), 2);
+      distance.build(soup_view(soup), 2);
+      for (int frame = 0; frame < 2; ++frame) {
+        SCOPED_TRACE("frame " + std::to_string(frame));
+        expect_search_boxes(search, soup, collapsed);
+        expect_boxes_nest(distance, soup);
+        const TreeView view = search.view();
+        const PairMultiset expected = overlapping_box_pairs(soup, collapsed);
+        ASSERT_EQ(per_leaf_pairs(view), expected);
+        ASSERT_EQ(grouped_pairs<4>(view), expected);
+        ASSERT_EQ(grouped_pairs<8>(view), expected);
+        int64_t handed_over = 0;
+        ASSERT_EQ(split_walk_pairs(view, split_walk_level(view.shape), handed_over), expected);
+        ASSERT_EQ(per_leaf_pairs(distance.view()), overlapping_box_pairs(soup, none));
+        // Empty leaves add nothing to the quality: the same sum as over the other boxes.
+        double sum = 0.0;
+        for (int32_t node = 0; node < n - 1; ++node) sum += geom::half_area(search.boxes()[node]);
+        const double root = geom::half_area(search.boxes()[0]);
+        if (n > 1) EXPECT_NEAR(search.quality(2), sum / root, 1e-12 * sum / root);
+        // Move every triangle, a collapsed one as a whole, and refit.
+        std::mt19937 rng(seed + 1);
+        std::uniform_real_distribution<double> move(-1.0, 1.0);
+        for (int32_t t = 0; t < n; ++t) {
+          const geom::Vec3d by{move(rng), move(rng), move(rng)};
+          for (int k = 0; k < 3; ++k) {
+            geom::Vec3d& p = soup.positions[soup.triangles[t].v[k]];
+            p = p + (collapsed[t] ? by : geom::Vec3d{move(rng), move(rng), move(rng)});
+          }
+        }
+        search.refit(soup_view(soup), 2);
+        distance.refit(soup_view(soup), 2);
+      }
+    }
+  }
+}
+
+TEST(Tree, ATreeOfCollapsedTrianglesOnlyIsEmptyWithQualityZero) {
+  // A frame whose positions were all zeroed: every leaf, so every node, has the empty box.
+  for (int32_t n : {1, 2, 7, 1000}) {
+    Soup soup = random_soup(n, 3, 0.5);
+    Tree tree;
+    tree.build(soup_view(soup), 2);
+    for (auto& p : soup.positions) p = {0.0, 0.0, 0.0};
+    tree.refit(soup_view(soup), 2);
+    const geom::Box3f empty = geom::empty_box();
+    for (const geom::Box3f& box : tree.boxes())
+      ASSERT_EQ(std::memcmp(&box, &empty, sizeof box), 0) << "n=" << n;
+    EXPECT_EQ(tree.quality(2), 0.0) << "n=" << n;
+    EXPECT_TRUE(per_leaf_pairs(tree.view()).empty()) << "n=" << n;
   }
 }
 

@@ -137,6 +137,26 @@ TEST(Detect, FansAboveTheListedValenceAreFoundByTheTraversal) {
           << threads << " threads, lanes " << detect::cpu_walk_lanes(width);
 }
 
+TEST(Detect, PilesOfCollapsedTrianglesAreDegenerateAndPairWithNothing) {
+  // Their leaves have empty boxes (bvh::leaf_box), so no walk reaches them; on a vertex and
+  // inside a face of the sheet, they would otherwise touch it.
+  const int32_t piled = 500;
+  const SmallMesh mesh = folded_grid_with_piles(piled);
+  const auto n = static_cast<int32_t>(mesh.triangles.size());
+  std::vector<int32_t> pile(static_cast<size_t>(piled));
+  for (int32_t i = 0; i < piled; ++i) pile[i] = n - piled + i;
+  const std::vector<detect::FacePair> expected = brute_force(mesh);
+  ASSERT_FALSE(expected.empty());
+  EXPECT_EQ(expected, brute_force(folded_grid(12, 8)));
+  for (int threads : {1, 2}) {
+    const detect::FrameResult result = check_mesh(mesh, threads);
+    EXPECT_EQ(result.pairs, expected) << threads << " threads";
+    EXPECT_EQ(result.degenerate, pile) << threads << " threads";
+    // The same candidates as the sheet alone: the piled triangles are none.
+    EXPECT_EQ(result.candidate_pairs, check_mesh(folded_grid(12, 8), threads).candidate_pairs);
+  }
+}
+
 TEST(Detect, EmptyAndSingleTriangleMeshes) {
   SmallMesh empty;
   empty.positions = {{0, 0, 0}};

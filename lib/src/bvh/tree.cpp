@@ -74,10 +74,18 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   const int32_t n = shape_.leaf_count;
   // Leaves in triangle order: the corners are read in file order (mostly sequential) and
   // only the box writes scatter, where leaf order would scatter every read.
+  auto fit_leaves = [&](auto&& box_of) {
 #pragma omp parallel for num_threads(threads) schedule(static) if (n > kParallelLevel)
-  for (int32_t t = 0; t < n; ++t) {
-    tree.boxes[leaf_of_triangle_[t]] = leaf_box(mesh.triangles[t], mesh);
-  }
+    for (int32_t t = 0; t < n; ++t) {
+      const geom::Tri tri = mesh.triangles[t];
+      tree.boxes[leaf_of_triangle_[t]] =
+          box_of(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
+    }
+  };
+  if (leaf_boxes_ == LeafBoxes::skip_collapsed)
+    fit_leaves([](geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) { return leaf_box(a, b, c); });
+  else
+    fit_leaves(geom::triangle_box);
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to
   // gain from threads run on one, without a barrier: barriers are what costs when the machine

@@ -22,10 +22,17 @@ struct TreeView {
   const int32_t* triangle_at = nullptr;  ///< n: the triangle of each leaf position
 };
 
-/// Box of triangle `tri` from its current corners: its leaf's box, on both backends.
-SNAG_HD_INLINE geom::Box3f leaf_box(const geom::Tri& tri, mesh::MeshView mesh) {
-  return geom::triangle_box(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]],
-                            mesh.positions[tri.v[2]]);
+/// The leaf box of a triangle with corners a, b and c, on both backends: their box, or the empty
+/// box when two corners coincide. Such a triangle has zero area, so every frame's degenerate
+/// scan leaves it out of the pair tests; an empty box overlaps no finite box, so the walks do
+/// not reach it either (the degenerate flags still guard the pair tests: boxes reaching past
+/// FLT_MAX overlap even an empty one). Without it, a pile of them at one point (a frame whose
+/// vertices were all zeroed, a region collapsed by a simulation gone wrong) made the walks
+/// quadratic: 200,000 such triangles took 11 s on two cores, now 0.4. Collinear corners that are
+/// distinct keep their box: telling them needs an exact predicate, and they do not pile up.
+SNAG_HD_INLINE geom::Box3f leaf_box(geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) {
+  const bool collapsed = (a == b) | (b == c) | (c == a);
+  return collapsed ? geom::empty_box() : geom::triangle_box(a, b, c);
 }
 
 /// Box of internal node `node` from its children's (already refit) boxes.
@@ -270,9 +277,21 @@ SNAG_HD_INLINE double quality_from_blocks(const double* block_sums, int32_t bloc
   return blocks > 0 && root_area > 0.0 ? sum / root_area : 0.0;
 }
 
+/// What a leaf's box bounds.
+enum class LeafBoxes {
+  /// leaf_box: a triangle with two coincident corners gets the empty box. For the pair search,
+  /// which leaves such triangles out (the CUDA backend's trees are always of this kind).
+  skip_collapsed,
+  /// geom::triangle_box: every triangle, a collapsed one included (a point or a segment is still
+  /// on the surface). For distance queries (measure::PenetrationMeter).
+  every_triangle,
+};
+
 /// Owning tree on the host (the CPU backend; the CUDA backend keeps device buffers instead).
 class Tree {
  public:
+  explicit Tree(LeafBoxes leaf_boxes = LeafBoxes::skip_collapsed) : leaf_boxes_(leaf_boxes) {}
+
   /// Builds the paper's tree: sort the centroids of each segment along the longest axis of
   /// their bounds and split at the count the complete shape dictates, level by level, all
   /// segments of a level in parallel. Ties are broken by triangle id, so the tree is the same
@@ -296,6 +315,7 @@ class Tree {
   std::vector<geom::Box3f> boxes_;
   std::vector<int32_t> triangle_at_;
   std::vector<int32_t> leaf_of_triangle_;  ///< the inverse of triangle_at_: each triangle's leaf
+  LeafBoxes leaf_boxes_;
 };
 
 }  // namespace snag::bvh

@@ -92,8 +92,10 @@ SNAG_HD_INLINE bool contains(const Box3f& outer, const Box3f& inner) {
   return true;
 }
 
-/// Half the surface area; the tree-quality measure sums it over internal nodes.
+/// Half the surface area, 0 for an empty box (whose extents are negative); the tree-quality
+/// measure sums it over internal nodes.
 SNAG_HD_INLINE double half_area(const Box3f& b) {
+  if (b.hi[0] < b.lo[0]) return 0.0;  // empty_box() and merges of empty boxes only
   double dx = double(b.hi[0]) - b.lo[0], dy = double(b.hi[1]) - b.lo[1],
          dz = double(b.hi[2]) - b.lo[2];
   return dx * dy + dy * dz + dz * dx;

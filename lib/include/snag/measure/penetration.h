@@ -143,7 +143,7 @@ class PenetrationMeter {
   std::vector<geom::Vec3d> positions_;      ///< this frame's obstacle positions
   std::vector<geom::Vec3d> face_normal_;    ///< unit (zero for a zero-area triangle)
   std::vector<geom::Vec3d> vertex_normal_;  ///< angle-weighted sums of unit face normals
-  bvh::Tree tree_;
+  bvh::Tree tree_{bvh::LeafBoxes::every_triangle};
   double enclosed_volume_ = 0;
   double travel_ = 0;
   double extent_ = 0;  ///< the largest coordinate magnitude of the positions, for the margin
