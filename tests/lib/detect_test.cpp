@@ -157,6 +157,24 @@ TEST(Detect, PilesOfCollapsedTrianglesAreDegenerateAndPairWithNothing) {
   }
 }
 
+TEST(Detect, TheScanCertifiesCollapsedTrianglesSoTheirEmptyBoxesLoseNoCandidate) {
+  // The backends find candidates by overlapping boxes (the CPU's neighbour list aside), so a
+  // triangle whose leaf box is empty must be in the scan's certain list: never left to the exact
+  // stage, whose answer the backends do not wait for.
+  for (int32_t n : {10, 300, 2000}) {
+    SmallMesh soup = random_soup(n, static_cast<uint32_t>(n), 0.5);
+    const std::vector<int32_t> collapsed = collapse_soup_triangles(soup, 5, 2, {4.0, 4.0, 4.0});
+    const detect::Topology topology =
+        detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
+    auto backend = detect::make_cpu_backend(2);
+    backend->set_topology(topology);  // held by reference
+    backend->set_positions(soup.positions);
+    const detect::DegeneracyScan scan = backend->scan_degenerate();
+    EXPECT_EQ(scan.degenerate, collapsed) << "n=" << n;
+    EXPECT_TRUE(scan.uncertain.empty()) << "n=" << n;
+  }
+}
+
 TEST(Detect, EmptyAndSingleTriangleMeshes) {
   SmallMesh empty;
   empty.positions = {{0, 0, 0}};

@@ -121,6 +121,31 @@ TEST(Predicates, NearDegenerateSignsAreUncertainNotWrong) {
   EXPECT_LT(certain, 3 * 65);  // most of these are beyond the filter
 }
 
+TEST(Predicates, TwoCoincidentCornersAreCertainlyDegenerate) {
+  // A triangle with two corners at one point has an empty leaf box (bvh::leaf_box), which no
+  // walk enters, so the scan must list it as degenerate without the exact stage: the filter
+  // certifies orient2d's zero when two of its points coincide. With a == b and c elsewhere the
+  // rounded products acx * bcy and acy * bcx are equal but not zero, and the bound alone left
+  // the sign uncertain.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> coordinate(-3.0, 3.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<geom::Vec3d> points(3);
+    for (auto& p : points) p = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    const int same = trial % 3;  // which corner moves onto the next one
+    points[same] = points[(same + 1) % 3];
+    const geom::FilteredPredicates filtered{points.data()};
+    ASSERT_EQ(geom::is_degenerate(filtered, 0, 1, 2), geom::Answer::yes) << "trial " << trial;
+    for (int axis = 0; axis < 3; ++axis)
+      ASSERT_EQ(filtered.orient2d(0, 1, 2, axis), geom::Sign::zero) << "trial " << trial;
+  }
+  // Points that differ, however little, are still left to the exact stage when the filter
+  // cannot tell.
+  const std::vector<geom::Vec3d> near{
+      {0.1, 0.2, 0.3}, {std::nextafter(0.1, 1.0), 0.2, 0.3}, {0.7, 1.1, 0.3}};
+  EXPECT_NE(geom::orient2d(near[0], near[1], near[2], 2), geom::Sign::zero);
+}
+
 /// Random pairs of triangles on a small integer grid (many touching configurations: ends of
 /// the two segments that coincide, edges through the other's edges or corners), six vertices,
 /// no vertex shared. Calls f(points, sides of the first against the second's plane, sides of

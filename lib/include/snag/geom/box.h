@@ -93,12 +93,16 @@ SNAG_HD_INLINE bool contains(const Box3f& outer, const Box3f& inner) {
 }
 
 /// Half the surface area, 0 for an empty box (whose extents are negative); the tree-quality
-/// measure sums it over internal nodes.
+/// measure sums it over internal nodes. The extents are clamped by selects, not an early return:
+/// nvcc 13.0 compiled the return inside the GPU quality kernel's unrolled loop with the next
+/// box's offsets for two of the six loads (cuda/NOTES.md, "A miscompiled early return").
 SNAG_HD_INLINE double half_area(const Box3f& b) {
-  if (b.hi[0] < b.lo[0]) return 0.0;  // empty_box() and merges of empty boxes only
-  double dx = double(b.hi[0]) - b.lo[0], dy = double(b.hi[1]) - b.lo[1],
-         dz = double(b.hi[2]) - b.lo[2];
-  return dx * dy + dy * dz + dz * dx;
+  double extent[3];
+  for (int k = 0; k < 3; ++k) {
+    const double e = double(b.hi[k]) - b.lo[k];
+    extent[k] = e > 0.0 ? e : 0.0;
+  }
+  return extent[0] * extent[1] + extent[1] * extent[2] + extent[2] * extent[0];
 }
 
 }  // namespace snag::geom
