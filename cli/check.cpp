@@ -93,6 +93,31 @@ std::vector<report::ObjectInput> object_inputs(const scene::ResolvedScene& scene
   return objects;
 }
 
+/// Frames in which every triangle has zero area: a cache frame written with its vertices zeroed,
+/// or a simulation collapsed to a point. Their faces pair with nothing, so they check clean and
+/// a gate would pass them in silence. The first kNamed are named in a warning as they are
+/// checked, the rest counted in one at the end.
+class CollapsedFrames {
+ public:
+  static constexpr int64_t kNamed = 3;
+  using Warn = std::function<void(const std::string&)>;
+
+  void note(const report::FrameRecord& r, const Warn& warn) {
+    if (r.triangles == 0 || static_cast<int64_t>(r.degenerate.size()) < r.triangles) return;
+    if (++count_ > kNamed) return;
+    warn("frame " + std::to_string(r.frame) + " (" + r.file + "): all " +
+         std::to_string(r.triangles) +
+         " triangles have zero area (vertices zeroed or collapsed?); it checks clean");
+  }
+  void finish(const Warn& warn) const {
+    if (count_ > kNamed)
+      warn(std::to_string(count_ - kNamed) + " more frames have only zero-area triangles");
+  }
+
+ private:
+  int64_t count_ = 0;
+};
+
 std::string frame_note(const report::FrameRecord& r) {
   std::string note = "frame " + std::to_string(r.frame) + ": ";
   if (r.pairs.empty()) {
@@ -350,13 +375,16 @@ int run_check(const CheckOptions& o) {
   sequence.weld = o.weld;
   sequence.threads = threads;
   sequence.gpu = backend_name == "cuda";
+  CollapsedFrames collapsed;
   check_scene(
       resolved, *checker, sequence, scene_run, inputs,
       [&](report::FrameRecord&& record) {
+        collapsed.note(record, warn);
         progress.update(reports.summary().frames_checked + 1, frame_note(record));
         reports.add(std::move(record));
       },
       warn);
+  collapsed.finish(warn);
   progress.finish();
 
   RunTotals totals;

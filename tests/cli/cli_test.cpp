@@ -227,6 +227,35 @@ TEST(CliCheck, FilesWithoutTrianglesWarnAndCheckClean) {
   EXPECT_EQ(cloth.err, "") << "--quiet: no warning";
 }
 
+// A frame whose vertices were all zeroed (a failed cache write) has only zero-area triangles:
+// it checks clean, so a warning names it (the first three, then a count of the rest).
+TEST(CliCheck, FramesOfOnlyZeroAreaTrianglesAreNamed) {
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "seq");
+  const std::string faces = "f 1 2 3\nf 1 3 4\n";
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n" + faces;
+  const std::string zeroed = "v 0 0 0\nv 0 0 0\nv 0 0 0\nv 0 0 0\n" + faces;
+  for (int frame = 1; frame <= 8; ++frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "f.%04d.obj", frame);
+    write_text(tmp.path() / "seq" / name, frame == 1 || frame == 8 ? square : zeroed);
+  }
+  const RunResult r = run_snag({"check", "seq", "--out", "r"}, tmp.path());
+  EXPECT_EQ(r.status, 0) << context(r);
+  for (int frame : {2, 3, 4})
+    EXPECT_NE(r.err.find("frame " + std::to_string(frame) + " (seq/f.000" + std::to_string(frame) +
+                         ".obj): all 2 triangles have zero area (vertices zeroed or collapsed?)"),
+              std::string::npos)
+        << r.err;
+  EXPECT_EQ(r.err.find("frame 5 (seq"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 more frames have only zero-area triangles"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("frame 1 (seq"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("frame 8 (seq"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("degenerate faces     12"), std::string::npos) << r.out;
+  const RunResult quiet = run_snag({"check", "seq", "-q"}, tmp.path());
+  EXPECT_EQ(quiet.err, "") << "--quiet: no warning";
+}
+
 // Ctrl-C or a farm's kill midway: the run ends by that signal, and its output directory holds
 // no report temporary (only finished reports would be there, and there are none yet).
 TEST(CliCheck, KilledRunLeavesNoTemporaries) {
