@@ -93,29 +93,43 @@ std::vector<report::ObjectInput> object_inputs(const scene::ResolvedScene& scene
   return objects;
 }
 
-/// Frames in which every triangle has zero area: a cache frame written with its vertices zeroed,
-/// or a simulation collapsed to a point. Their faces pair with nothing, so they check clean and
-/// a gate would pass them in silence. The first kNamed are named in a warning as they are
-/// checked, the rest counted in one at the end.
+/// Frames in which every triangle of an object has zero area: a cache frame written with its
+/// vertices zeroed, or a simulation collapsed to a point. Its faces pair with nothing, so the
+/// frame checks clean and a gate would pass it in silence. The objects of the first kNamed such
+/// frames are named in a warning as they are checked, the other frames counted in one at the end.
 class CollapsedFrames {
  public:
   static constexpr int64_t kNamed = 3;
   using Warn = std::function<void(const std::string&)>;
 
   void note(const report::FrameRecord& r, const Warn& warn) {
-    if (r.triangles == 0 || static_cast<int64_t>(r.degenerate.size()) < r.triangles) return;
-    if (++count_ > kNamed) return;
-    warn("frame " + std::to_string(r.frame) + " (" + r.file + "): all " +
-         std::to_string(r.triangles) +
-         " triangles have zero area (vertices zeroed or collapsed?); it checks clean");
+    if (r.degenerate.empty()) return;
+    // A single mesh is one object; a scene's degenerate faces say which object they are in.
+    std::vector<int64_t> degenerate(std::max<size_t>(r.objects.size(), 1), 0);
+    for (const report::Face& f : r.degenerate)
+      if (static_cast<size_t>(f.object) < degenerate.size()) ++degenerate[f.object];
+    bool counted = false;
+    for (size_t o = 0; o < degenerate.size(); ++o) {
+      const int64_t triangles = r.objects.empty() ? r.triangles : r.objects[o].triangles;
+      if (triangles == 0 || degenerate[o] < triangles) continue;
+      if (!counted) ++frames_;
+      counted = true;
+      if (frames_ > kNamed) return;
+      const std::string& file = r.objects.empty() ? r.file : r.objects[o].file;
+      warn("frame " + std::to_string(r.frame) + " (" + file + "): all " +
+           std::to_string(triangles) +
+           " triangles have zero area (vertices zeroed or collapsed?); they pair with nothing");
+    }
   }
   void finish(const Warn& warn) const {
-    if (count_ > kNamed)
-      warn(std::to_string(count_ - kNamed) + " more frames have only zero-area triangles");
+    const int64_t more = frames_ - kNamed;
+    if (more > 0)
+      warn(std::to_string(more) + (more == 1 ? " more frame has" : " more frames have") +
+           " an object of only zero-area triangles");
   }
 
  private:
-  int64_t count_ = 0;
+  int64_t frames_ = 0;
 };
 
 std::string frame_note(const report::FrameRecord& r) {

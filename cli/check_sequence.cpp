@@ -628,7 +628,8 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
       for (int32_t o = 0; o < object_count; ++o) {
         const detect::PartOutcome& part = result.parts[o];
         record.objects.push_back({scene_frame.files[o], part.moved != 0, part.rebuilt,
-                                  part.build_seconds, part.refit_seconds, part.tree_quality});
+                                  part.build_seconds, part.refit_seconds, part.tree_quality,
+                                  layout.triangle_begin[o + 1] - layout.triangle_begin[o]});
       }
       // Penetration: measured again only when the cloth or the obstacle moved.
       std::vector<report::Penetration> penetration;

@@ -187,18 +187,20 @@ inline SmallMesh random_soup(int32_t n, uint32_t seed, double size) {
 
 /// Collapses every `every`-th triangle of a soup whose triangles have three vertices of their own
 /// (random_soup), from `first` on: in turn all three corners onto `pile`, one point shared by all
-/// of them, and the second corner onto the first. Zero-area triangles whose leaves get the empty
-/// box (bvh::leaf_box). Returns their ids in order.
+/// of them, then the second corner onto the first, the third onto the second and the first onto
+/// the third (each pair that bvh::leaf_box compares). Zero-area triangles whose leaves get the
+/// empty box. Returns their ids in order.
 inline std::vector<int32_t> collapse_soup_triangles(SmallMesh& soup, int32_t every, int32_t first,
                                                     geom::Vec3d pile) {
   std::vector<int32_t> collapsed;
   const auto n = static_cast<int32_t>(soup.triangles.size());
   for (int32_t t = first; t < n; t += every) {
     const geom::Tri tri = soup.triangles[t];
-    if (collapsed.size() % 2 == 0)
+    const auto turn = static_cast<int>(collapsed.size() % 4);
+    if (turn == 0)
       for (int k = 0; k < 3; ++k) soup.positions[tri.v[k]] = pile;
-    else
-      soup.positions[tri.v[1]] = soup.positions[tri.v[0]];
+    else  // corner `turn % 3` onto corner `turn - 1`
+      soup.positions[tri.v[turn % 3]] = soup.positions[tri.v[turn - 1]];
     collapsed.push_back(t);
   }
   return collapsed;

@@ -248,12 +248,23 @@ TEST(CliCheck, FramesOfOnlyZeroAreaTrianglesAreNamed) {
               std::string::npos)
         << r.err;
   EXPECT_EQ(r.err.find("frame 5 (seq"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("3 more frames have only zero-area triangles"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 more frames have an object of only zero-area triangles"),
+            std::string::npos)
+      << r.err;
   EXPECT_EQ(r.err.find("frame 1 (seq"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("frame 8 (seq"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("degenerate faces     12"), std::string::npos) << r.out;
   const RunResult quiet = run_snag({"check", "seq", "-q"}, tmp.path());
   EXPECT_EQ(quiet.err, "") << "--quiet: no warning";
+  // Beside an obstacle, the zeroed object is named, not the frame as a whole.
+  write_text(tmp.path() / "body.obj", "v 5 5 5\nv 6 5 5\nv 5 6 5\nf 1 2 3\n");
+  const RunResult scene = run_snag({"check", "seq", "--obstacle", "body.obj"}, tmp.path());
+  EXPECT_EQ(scene.status, 0) << context(scene);
+  EXPECT_NE(scene.err.find("frame 2 (seq/f.0002.obj): all 2 triangles have zero area"),
+            std::string::npos)
+      << scene.err;
+  EXPECT_EQ(scene.err.find("body.obj): all"), std::string::npos) << scene.err;
+  EXPECT_NE(scene.err.find("3 more frames have"), std::string::npos) << scene.err;
 }
 
 // Ctrl-C or a farm's kill midway: the run ends by that signal, and its output directory holds

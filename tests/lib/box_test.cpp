@@ -94,7 +94,7 @@ TEST(Box, TriangleBoxContainsItsCornersExactly) {
   EXPECT_EQ(box.lo[2], reference_down(-0.7));
 }
 
-TEST(Box, AnEmptyBoxOverlapsNoFiniteBoxHasNoAreaAndLeavesMergesAlone) {
+TEST(Box, AnEmptyBoxOverlapsNoBoxShortOfFltMaxHasNoAreaAndLeavesMergesAlone) {
   const Box3f empty = empty_box();
   const Box3f point = triangle_box({1, 2, 3}, {1, 2, 3}, {1, 2, 3});
   const Box3f wide = triangle_box({-1e30, -1e30, -1e30}, {1e30, 1e30, 1e30}, {0, 0, 0});

@@ -191,9 +191,11 @@ FrameResult Checker::check(const FrameInput& input) {
       part.refit_seconds = seconds_since(start);
       // Asked once: on the CPU the quality is a pass over every internal node.
       last_quality_[p] = backend_->part_quality(p);
-      if (settings_.rebuild == RebuildPolicy::automatic && built_quality_[p] > 0 &&
-          last_quality_[p] > settings_.rebuild_threshold * built_quality_[p])
-        build(true);
+      // A tree built on a frame of no extent (every triangle at one point: a zeroed frame) has
+      // quality 0, to which no ratio compares: the first frame with a quality rebuilds it.
+      const double built = built_quality_[p], now = last_quality_[p];
+      const bool degraded = built > 0 ? now > settings_.rebuild_threshold * built : now > 0;
+      if (settings_.rebuild == RebuildPolicy::automatic && degraded) build(true);
     }
     if (part.rebuilt) last_quality_[p] = built_quality_[p];
     part.tree_quality = last_quality_[p];

@@ -360,7 +360,8 @@ class CpuBackend final : public Backend {
     return frame;
   }
 
-  /// A part against itself: its neighbour pairs from their list (their boxes always overlap),
+  /// A part against itself: its neighbour pairs from their list (their boxes overlap, but for a
+  /// collapsed triangle's empty one: it is degenerate, so skipped here too),
   /// a triangle's pairs at a time, those of a triangle whose corners all have clear fans
   /// skipped whole (98% of a settled cloth's triangles), then the other candidates from its tree,
   /// the leaves in groups of 4 or 8 consecutive positions (walk_self_group), groups in leaf order;

@@ -23,10 +23,11 @@ struct TreeView {
 };
 
 /// The leaf box of a triangle with corners a, b and c, on both backends: their box, or the empty
-/// box when two corners coincide. Such a triangle has zero area, so every frame's degenerate
-/// scan leaves it out of the pair tests; an empty box overlaps no finite box, so the walks do
-/// not reach it either (the degenerate flags still guard the pair tests: boxes reaching past
-/// FLT_MAX overlap even an empty one). Without it, a pile of them at one point (a frame whose
+/// box when two corners coincide. The walks find candidates by overlapping boxes and an empty
+/// box overlaps nothing but boxes reaching +-FLT_MAX on every axis, so such a triangle must be
+/// one every frame's degenerate scan certainly lists (the filtered orient2d certifies the zeros
+/// of coincident points), which the pair tests leave out anyway; the degenerate flags still
+/// guard them. Without it, a pile of them at one point (a frame whose
 /// vertices were all zeroed, a region collapsed by a simulation gone wrong) made the walks
 /// quadratic: 200,000 such triangles took 11 s on two cores, now 0.4. Collinear corners that are
 /// distinct keep their box: telling them needs an exact predicate, and they do not pile up.

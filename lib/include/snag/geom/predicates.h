@@ -68,10 +68,11 @@ SNAG_HD_INLINE Sign orient2d(double ax, double ay, double bx, double by, double 
     return detail::sign_of(det);
   // Both products exactly zero because a difference is exactly zero: the determinant is zero.
   if ((acx == 0.0 || bcy == 0.0) && (acy == 0.0 || bcx == 0.0)) return Sign::zero;
-  // Two of the points coincide: the determinant is zero, though its rounded products need not
-  // be (a == b gives acx * acy - acy * acx). So a triangle with two coincident corners, whose
-  // leaf box is empty (bvh::leaf_box), is certainly degenerate in the scan on both backends.
-  if ((ax == bx && ay == by) || (ax == cx && ay == cy) || (bx == cx && by == cy)) return Sign::zero;
+  // a == b: the determinant is zero, though its rounded products need not be (acx * acy -
+  // acy * acx). (a == c or b == c makes a difference exactly zero, caught above.) So a triangle
+  // with two coincident corners, whose leaf box is empty (bvh::leaf_box), is certainly
+  // degenerate in the scan on both backends.
+  if (ax == bx && ay == by) return Sign::zero;
   return Sign::uncertain;
 }
 

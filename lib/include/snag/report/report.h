@@ -61,6 +61,7 @@ struct ObjectFrame {
   double build_seconds = 0;
   double refit_seconds = 0;
   double tree_quality = 0;
+  int32_t triangles = 0;  ///< this frame's (not written: the reports give the first frame's)
   friend bool operator==(const ObjectFrame&, const ObjectFrame&) = default;
 };
 
