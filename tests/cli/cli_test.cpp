@@ -369,6 +369,7 @@ TEST(CliStatus, UsageErrorsExitTwo) {
       {"check", "seq", "--frames", "100-200"},
       {"check", "seq", "--frames", ""},
       {"check", "seq", "--out", ""},
+      {"check", "seq", "--out", "-q"},  // wrote the reports into ./-q
       {"bench"},
   };
   for (const auto& args : cases) {
@@ -379,6 +380,10 @@ TEST(CliStatus, UsageErrorsExitTwo) {
     EXPECT_FALSE(r.err.empty()) << "snag" << line << " says nothing";
     EXPECT_EQ(r.err.rfind("snag: error: ", 0), 0u) << "snag" << line << ": " << r.err;
   }
+  EXPECT_FALSE(fs::exists(tmp.path() / "-q"));
+  const RunResult dashed = run_snag({"check", "seq", "--out", "./-q", "-q"}, tmp.path());
+  EXPECT_EQ(dashed.status, 1) << context(dashed);
+  EXPECT_TRUE(fs::exists(tmp.path() / "-q" / "pairs.csv"));
   // A word that names no command is named (and its --help is no help that exits 0).
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"report"}, std::vector<std::string>{"report", "--help"}}) {
