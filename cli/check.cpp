@@ -213,7 +213,8 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
   const double per_frame = s.frames_checked > 0 ? s.check_seconds / s.frames_checked : 0.0;
   out << "time                 " << fixed(s.check_seconds, 3) << " s checking ("
       << fixed(per_frame * 1e3, 2) << " ms per frame), " << fixed(s.read_seconds, 3)
-      << " s reading, " << fixed(totals.wall_seconds, 3) << " s in all\n";
+      << " s reading (ahead, on other threads), " << fixed(totals.wall_seconds, 3)
+      << " s in all\n";
   out << "tree                 " << plural(totals.builds, "build") << ", "
       << plural(totals.rebuilds, "rebuild") << " (--rebuild " << rebuild_policy << "), "
       << plural(s.topology_changes, "topology change") << "\n";
