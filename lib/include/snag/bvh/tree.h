@@ -23,14 +23,14 @@ struct TreeView {
 };
 
 /// The leaf box of a triangle with corners a, b and c, on both backends: their box, or the empty
-/// box when two corners coincide. The walks find candidates by overlapping boxes and an empty
-/// box overlaps nothing but boxes reaching +-FLT_MAX on every axis, so such a triangle must be
-/// one every frame's degenerate scan certainly lists (the filtered orient2d certifies the zeros
-/// of coincident points), which the pair tests leave out anyway; the degenerate flags still
-/// guard them. Without it, a pile of them at one point (a frame whose
-/// vertices were all zeroed, a region collapsed by a simulation gone wrong) made the walks
-/// quadratic: 200,000 such triangles took 11 s on two cores, now 0.4. Collinear corners that are
-/// distinct keep their box: telling them needs an exact predicate, and they do not pile up.
+/// box when two corners coincide. Without it, a pile of such triangles at one point (a frame
+/// whose vertices were all zeroed, a region collapsed by a simulation gone wrong) made the walks
+/// quadratic: 200,000 of them took 11 s on two cores, now 0.4. The walks find candidates by
+/// overlapping boxes, and an empty box overlaps nothing but boxes reaching +-FLT_MAX on every
+/// axis; so such a triangle must be one that every frame's degenerate scan certainly lists (the
+/// filtered orient2d certifies the zeros of coincident points), which the pair tests leave out
+/// anyway, their degenerate flags still guarding them. Collinear corners that are distinct keep
+/// their box: telling them needs an exact predicate, and they do not pile up.
 SNAG_HD_INLINE geom::Box3f leaf_box(geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) {
   const bool collapsed = (a == b) | (b == c) | (c == a);
   return collapsed ? geom::empty_box() : geom::triangle_box(a, b, c);
