@@ -39,26 +39,25 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// An option value that may not be empty (`--frames ''` would select nothing, silently).
+/// An option value that may not be empty (`--out ''` would write no report, `--frames ''`
+/// select nothing, silently).
 CLI::Validator non_empty(const std::string& what) {
   return CLI::Validator(
       [what](std::string& value) { return value.empty() ? "expected " + what + ", found ''" : ""; },
       "", "non-empty");
 }
 
-/// A directory option's value: not empty (`--out ''` would write no report, silently) and not
-/// an option (`--out -q` took -q as the directory and wrote the reports into ./-q; a directory
-/// of that name is still ./-q).
-CLI::Validator directory_name(const std::string& what) {
+/// A directory option's value that is not an option: `--out -q` took -q as the directory and
+/// wrote the reports into ./-q (a directory of that name is still ./-q).
+CLI::Validator not_an_option(const std::string& what) {
   return CLI::Validator(
       [what](std::string& value) -> std::string {
-        if (value.empty()) return "expected " + what + ", found ''";
         if (value.size() > 1 && value[0] == '-')
           return "expected " + what + ", found the option " + value + " (a directory of that " +
                  "name is ./" + value + ")";
         return "";
       },
-      "", "directory name");
+      "", "not an option");
 }
 
 detect::RebuildPolicy rebuild_policy(const std::string& name) {
@@ -274,7 +273,8 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
   cmd->add_option("-o,--out", o.out_dir,
                   "Write pairs.csv, frames.csv and report.json into DIR (created if missing)")
       ->type_name("DIR")
-      ->check(directory_name("a directory"));
+      ->check(non_empty("a directory"))
+      ->check(not_an_option("a directory"));
   cmd->add_option("--frames", o.frames, "Check only these frames: 1-240, 1-240x5, 1-10,20-30")
       ->type_name("SEL")
       ->check(non_empty("a frame selection"));

@@ -32,6 +32,21 @@ std::unique_ptr<cuda::CudaBackend> gpu_backend() {
   return std::unique_ptr<cuda::CudaBackend>(gpu);
 }
 
+/// A CPU backend (two threads) and a GPU backend on one topology, which must outlive them (the
+/// backends hold it by reference); the GPU's result buffers start at `capacity` when it is given,
+/// so that their growth is exercised.
+struct BothBackends {
+  std::unique_ptr<detect::Backend> cpu;
+  std::unique_ptr<cuda::CudaBackend> gpu;
+};
+BothBackends both_backends(const detect::Topology& topology, int64_t capacity = 0) {
+  BothBackends both{detect::make_cpu_backend(2), gpu_backend()};
+  if (capacity > 0) both.gpu->set_result_capacity(capacity);
+  both.cpu->set_topology(topology);
+  both.gpu->set_topology(topology);
+  return both;
+}
+
 /// Runs one frame through a backend the way the checker does, filter only.
 struct Filtered {
   detect::DegeneracyScan scan;
@@ -74,11 +89,7 @@ void expect_same_filtered(const SmallMesh& mesh, const std::string& what, int64_
                           detect::FilterUse use = detect::FilterUse::certify) {
   const detect::Topology topology =
       detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
-  auto cpu = detect::make_cpu_backend(2);
-  auto gpu = gpu_backend();
-  if (capacity > 0) gpu->set_result_capacity(capacity);
-  cpu->set_topology(topology);
-  gpu->set_topology(topology);
+  auto [cpu, gpu] = both_backends(topology, capacity);
   expect_same(filtered(*cpu, mesh.positions, true, use), filtered(*gpu, mesh.positions, true, use),
               what);
 }
@@ -285,10 +296,7 @@ TEST(CudaDetect, DegenerateFacesComeAndGoBetweenFrames) {
   SmallMesh mesh = folded_grid(12, 8);
   const detect::Topology topology =
       detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
-  auto cpu = detect::make_cpu_backend(2);
-  auto gpu = gpu_backend();
-  cpu->set_topology(topology);
-  gpu->set_topology(topology);
+  auto [cpu, gpu] = both_backends(topology);
   for (int frame = 0; frame < 4; ++frame) {
     SmallMesh moved = mesh;
     if (frame % 2 == 1) {
@@ -318,10 +326,7 @@ TEST(CudaDetect, PilesOfCollapsedTrianglesAndAZeroedFrameMatchTheCpu) {
   const SmallMesh mesh = folded_grid(12, 8);
   const detect::Topology topology =
       detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
-  auto cpu = detect::make_cpu_backend(2);
-  auto gpu = gpu_backend();
-  cpu->set_topology(topology);
-  gpu->set_topology(topology);
+  auto [cpu, gpu] = both_backends(topology);
   SmallMesh zeroed = mesh;
   for (auto& p : zeroed.positions) p = {0.0, 0.0, 0.0};
   for (int frame = 0; frame < 3; ++frame) {
@@ -468,10 +473,7 @@ TEST(CudaDetect, FanClearedNeighboursLeftOutCountAsOnTheCpu) {
       detect::make_topology(flat.triangles, static_cast<int32_t>(flat.positions.size()));
   ASSERT_FALSE(topology.fan_steps.empty());
   const int64_t neighbour_pairs = topology.neighbor_begin.back();
-  auto cpu = detect::make_cpu_backend(2);
-  auto gpu = gpu_backend();
-  cpu->set_topology(topology);
-  gpu->set_topology(topology);
+  auto [cpu, gpu] = both_backends(topology);
   SmallMesh degenerate = sheet(4);
   degenerate.positions[degenerate.triangles[500].v[0]] =
       degenerate.positions[degenerate.triangles[500].v[1]];
@@ -820,11 +822,7 @@ TEST(CudaBackend, FramesQueuedAheadGiveThePlainAnswers) {
   const detect::Topology topology =
       detect::make_topology(walk[0].triangles, static_cast<int32_t>(walk[0].positions.size()));
   for (int64_t capacity : {int64_t{0}, int64_t{1}}) {
-    auto cpu = detect::make_cpu_backend(2);
-    auto gpu = gpu_backend();
-    if (capacity > 0) gpu->set_result_capacity(capacity);
-    cpu->set_topology(topology);
-    gpu->set_topology(topology);
+    auto [cpu, gpu] = both_backends(topology, capacity);
     for (int f = 0; f < 14; ++f) {
       const std::string what = "capacity " + std::to_string(capacity) + " frame " + std::to_string(f);
       const bool build = f == 0 || f == 7;  // frame 7: a rebuild after its work was queued ahead

@@ -77,13 +77,19 @@ std::string soup_case(int32_t n, double size, uint32_t seed) {
          " seed=" + std::to_string(seed);
 }
 
-void expect_boxes_nest(const Tree& tree, const Soup& soup) {
+/// Every internal node's box holds its children's.
+void expect_children_nest(const Tree& tree) {
   const auto& boxes = tree.boxes();
-  const CompleteTree& shape = tree.shape();
-  for (int32_t node = 0; node < shape.leaf_count - 1; ++node) {
+  for (int32_t node = 0; node < tree.shape().leaf_count - 1; ++node) {
     ASSERT_TRUE(geom::contains(boxes[node], boxes[2 * node + 1])) << "node " << node;
     ASSERT_TRUE(geom::contains(boxes[node], boxes[2 * node + 2])) << "node " << node;
   }
+}
+
+void expect_boxes_nest(const Tree& tree, const Soup& soup) {
+  const auto& boxes = tree.boxes();
+  const CompleteTree& shape = tree.shape();
+  expect_children_nest(tree);
   for (int32_t p = 0; p < shape.leaf_count; ++p) {
     const geom::Box3f& box = boxes[shape.leaf_at(p)];
     const geom::Tri t = soup.triangles[tree.triangle_at()[p]];
@@ -486,10 +492,7 @@ void expect_search_boxes(const Tree& tree, const Soup& soup,
                          const std::vector<uint8_t>& collapsed) {
   const CompleteTree& shape = tree.shape();
   const geom::Box3f empty = geom::empty_box();
-  for (int32_t node = 0; node < shape.leaf_count - 1; ++node) {
-    ASSERT_TRUE(geom::contains(tree.boxes()[node], tree.boxes()[2 * node + 1])) << node;
-    ASSERT_TRUE(geom::contains(tree.boxes()[node], tree.boxes()[2 * node + 2])) << node;
-  }
+  expect_children_nest(tree);
   for (int32_t p = 0; p < shape.leaf_count; ++p) {
     const int32_t t = tree.triangle_at()[p];
     const geom::Box3f& box = tree.boxes()[shape.leaf_at(p)];

@@ -83,7 +83,7 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
     }
   };
   if (leaf_boxes_ == LeafBoxes::skip_collapsed)
-    fit_leaves([](geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) { return leaf_box(a, b, c); });
+    fit_leaves(leaf_box);
   else
     fit_leaves(geom::triangle_box);
   // One level at a time from the deepest internal level up, each level in parallel; the end
