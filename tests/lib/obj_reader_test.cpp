@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
@@ -502,6 +503,30 @@ TEST(ReadMesh, OtherFormatsGoThroughAssimpAndSaySo) {
   EXPECT_EQ(in_z0, 1);
   std::ofstream(dir / "junk.stl") << "this is not a mesh";
   EXPECT_THROW(read_mesh(dir / "junk.stl"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ReadMesh, MalformedFilesThroughAssimpAreInputErrorsNotCrashes) {
+  // Found by fuzzing: libassimp 5.2's OFF importer hands on a face without indices when its
+  // face line is missing or unreadable, and its triangulation then asserted (aborting the
+  // process) or read out of bounds (a segmentation fault). Validated first, each is an error
+  // naming the file.
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("snag_off_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::pair<const char*, std::string> cases[] = {
+      {"missing_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n"},
+      {"long_face_line.off", "OFF\n3 1 0\n0 1 0\n1 0 0\n0 0 0\ng " + std::string(4100, 'n') + "\n"},
+  };
+  for (const auto& [name, text] : cases) {
+    std::ofstream(dir / name) << text;
+    try {
+      read_mesh(dir / name);
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

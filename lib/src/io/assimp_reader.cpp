@@ -66,9 +66,12 @@ mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS);
-  const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices |
-                                           aiProcess_Triangulate);
+  // Validated first: an importer can hand the steps after it a malformed scene (an OFF file
+  // with a face line cut short or missing), on which libassimp 5.2's triangulation asserts
+  // (aborting the process) or reads out of bounds; validation turns that into an error.
+  const aiScene* scene = importer.ReadFile(
+      path.string(), aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
+                         aiProcess_JoinIdenticalVertices | aiProcess_Triangulate);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path.string(), 0,
                      std::string("assimp cannot read the file: ") + importer.GetErrorString());
