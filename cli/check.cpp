@@ -86,6 +86,9 @@ scene::Scene scene_of(const CheckOptions& o) {
       throw UsageError("--split-groups and --obstacle: use a scene file (--scene) to mix them");
     const std::vector<seq::Frame> frames = seq::resolve_sequence(o.sequence);
     const std::vector<std::string> groups = scene::face_groups(io::read_mesh(frames.front().path));
+    if (groups.empty())
+      throw InputError(frames.front().path.string(), 0,
+                       "has no faces, so no groups for --split-groups to check");
     return scene::scene_from_groups(o.sequence, groups, o.obstacle_groups, o.weld);
   }
   return scene::scene_from_flags(o.sequence, o.obstacles, o.weld);

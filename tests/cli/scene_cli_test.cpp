@@ -592,6 +592,29 @@ TEST(SceneSplitGroups, ObstacleGroupIsNotCheckedAgainstItself) {
   EXPECT_EQ(object_in(cloth.report.at("inputs").at("objects"), "body").at("role"), "cloth");
 }
 
+TEST(SceneSplitGroups, NothingToCheckIsAnErrorThatSaysWhy) {
+  // Found by fuzzing: both were the usage error "a scene needs at least one cloth", naming
+  // neither the file nor the options.
+  TempDir tmp;
+  write_text(tmp.path() / "empty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");  // no faces
+  const SceneRun empty = run_in(tmp.path(), {"empty.obj", "--split-groups"});
+  EXPECT_EQ(empty.result.status, 3) << context(empty.result);
+  EXPECT_NE(empty.result.err.find("empty.obj: has no faces, so no groups for --split-groups"),
+            std::string::npos)
+      << context(empty.result);
+  EXPECT_FALSE(fs::exists(tmp.path() / "out" / "report.json"));
+
+  write_text(tmp.path() / "body.obj",
+             obj_text(joined(post(0.5), bar), {{0, 1, 2}, {3, 4, 5}}, {"body", "body"}));
+  const SceneRun all =
+      run_in(tmp.path(), {"body.obj", "--split-groups", "--obstacle-group", "body"});
+  EXPECT_EQ(all.result.status, 2) << context(all.result);
+  EXPECT_NE(all.result.err.find("--obstacle-group names every group of body.obj (body); at least "
+                                "one must be a cloth"),
+            std::string::npos)
+      << context(all.result);
+}
+
 // Penetration ----------------------------------------------------------------------------------
 
 /// A cloth of two triangles: (a) three vertices inside the unit cube at depths 0.5 (its

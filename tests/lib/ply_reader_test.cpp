@@ -450,6 +450,18 @@ TEST(PlyReader, RejectsTruncatedBinary) {
   std::string huge = full;
   huge.replace(huge.find("vertex 4"), 8, "vertex 2000000000");
   expect_contains(reject(huge), "truncated");
+  // So does a face count too large for the bytes left. Faces vary in size: the message gives
+  // the bound, not a face the file would end inside (it named face 936 of a file that ends
+  // after face 71, found by fuzzing).
+  {
+    std::string many = full;
+    many.replace(many.find("face 2"), 6, "face 1000");
+    const InputError e = reject(many);
+    expect_contains(e,
+                    "the header declares 1000 face records, and the 30 bytes after this point "
+                    "hold at most 30 (each takes 1 byte or more)");
+    EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(many.size() - 30));
+  }
 }
 
 TEST(PlyReader, RejectsTruncatedAscii) {
@@ -602,6 +614,9 @@ TEST(PlyReader, RejectsMalformedHeaders) {
       {"", 0, "file is empty"},
       {"plx\nformat ascii 1.0\nend_header\n", 1, "expected 'ply' on the first line, found 'plx'"},
       {"ply\nformat ebcdic 1.0\n" + elements + "end_header\n", 2, "unknown PLY format 'ebcdic'"},
+      // Not the second one silently winning (found by fuzzing).
+      {"ply\nformat ascii 1.0\nformat binary_big_endian 1.0\n" + elements + "end_header\n", 3,
+       "a second 'format' line"},
       {"ply\n" + elements + "end_header\n", 8, "no 'format' line"},
       {"ply\nformat ascii 1.0\n" + elements, 8, "expected an 'end_header' line"},
       {"ply\nformat ascii 1.0\nelement vertex many\n", 3, "count 'many'"},

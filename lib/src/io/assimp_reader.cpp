@@ -7,8 +7,14 @@
 #include <assimp/scene.h>
 
 #include <assimp/Importer.hpp>
+#include <cctype>
+#include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <new>
+#include <string_view>
 
 #include "snag/error.h"
 
@@ -56,6 +62,50 @@ struct SceneFlattener {
   }
 };
 
+/// An OFF file's declared counts against its size, before assimp reserves room for them:
+/// libassimp 5.2's OFF importer allocates what the header says (a 60-byte file declaring a
+/// billion vertices took 12 GB, then aborted the process). Every vertex line takes at least 6
+/// bytes ("0 0 0\n"), every face line 2 ("0\n"). Headers this does not recognise (the 4OFF and
+/// nOFF variants, counts past the first 4 KB) are left to assimp.
+void check_off_counts(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  // Whitespace-separated words, '#' comments left out.
+  size_t at = 0;
+  auto next_word = [&]() -> std::string_view {
+    for (;;) {
+      while (at < head.size() && std::isspace(static_cast<unsigned char>(head[at]))) ++at;
+      if (at < head.size() && head[at] == '#') {
+        while (at < head.size() && head[at] != '\n') ++at;
+        continue;
+      }
+      const size_t begin = at;
+      while (at < head.size() && !std::isspace(static_cast<unsigned char>(head[at]))) ++at;
+      return std::string_view(head).substr(begin, at - begin);
+    }
+  };
+  const std::string_view keyword = next_word();
+  if (!keyword.ends_with("OFF") || keyword.find_first_of("4n") != std::string_view::npos) return;
+  uint64_t counts[2] = {};
+  for (uint64_t& count : counts) {
+    const std::string_view word = next_word();
+    if (at >= head.size() && head.size() == 4096) return;  // cut off by the 4 KB: left
+    if (std::from_chars(word.data(), word.data() + word.size(), count).ec != std::errc()) return;
+  }
+  std::error_code error;
+  const uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) return;
+  const auto [vertices, faces] = counts;
+  if (vertices > size / 6 || faces > size / 2 || 6 * vertices + 2 * faces > size)
+    throw InputError(path.string(), 0,
+                     "its header declares " + std::to_string(vertices) +
+                         (vertices == 1 ? " vertex and " : " vertices and ") +
+                         std::to_string(faces) + (faces == 1 ? " face" : " faces") +
+                         ", more than its " + std::to_string(size) + " bytes can hold");
+}
+
 }  // namespace
 
 mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
@@ -69,6 +119,9 @@ mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   // Validated first: an importer can hand the steps after it a malformed scene (an OFF file
   // with a face line cut short or missing), on which libassimp 5.2's triangulation asserts
   // (aborting the process) or reads out of bounds; validation turns that into an error.
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".off") check_off_counts(path);
   const aiScene* scene = importer.ReadFile(
       path.string(), aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
                          aiProcess_JoinIdenticalVertices | aiProcess_Triangulate);

@@ -259,6 +259,12 @@ class ObjParser {
     return true;
   }
 
+  /// An index no frame can hold (vertex ids are 32-bit), whatever the file lists later.
+  [[noreturn]] void index_past_any_count(const char* start) const {
+    fail("vertex index " + quote_token(start, end_) + " is out of range; a frame holds at most " +
+         std::to_string(std::numeric_limits<int32_t>::max()) + " vertices");
+  }
+
   void parse_face() {
     if (parse_plain_triangle()) return;
     ++p_;
@@ -271,9 +277,7 @@ class ObjParser {
       const char* first = detail::past_plus(p_, end_);
       int64_t index = 0;
       auto [ptr, ec] = detail::parse_integer(first, end_, index);
-      if (ec == std::errc::result_out_of_range) {
-        fail("vertex index " + quote_token(start, end_) + " is out of range");
-      }
+      if (ec == std::errc::result_out_of_range) index_past_any_count(start);
       if (ec != std::errc() || ptr == first ||
           (ptr < end_ && !is_blank_or_eol(*ptr) && *ptr != '/')) {
         fail("expected a vertex index (an integer, optionally followed by /vt/vn), found " +
@@ -285,9 +289,7 @@ class ObjParser {
       int64_t resolved;
       if (index > 0) {
         resolved = index - 1;
-        if (resolved >= std::numeric_limits<int32_t>::max()) {
-          fail("vertex index " + quote_token(start, end_) + " is out of range");
-        }
+        if (resolved >= std::numeric_limits<int32_t>::max()) index_past_any_count(start);
         // OBJ lists vertices before the faces that use them in practice, but nothing forbids a
         // face naming a later vertex: check those once the whole file is read.
         if (resolved >= listed) forward_.push_back({line_, index, std::string(start, p_)});

@@ -199,6 +199,9 @@ Header parse_header(std::string_view bytes, const std::string& name) {
       return h;
     }
     if (key == "format") {
+      // A second one would silently win, and the body be read in an encoding the first line
+      // did not say.
+      if (have_format) fail("a second 'format' line; a PLY header has one");
       if (words.size() != 3) fail("expected 'format <encoding> 1.0', found " + quote(text));
       if (words[1] == "ascii") {
         h.format = Format::ascii;
@@ -345,6 +348,15 @@ void add_polygon(mesh::Mesh& m, const std::vector<int32_t>& corners, int32_t pol
   }
 }
 
+/// "1 byte", "12 bytes".
+std::string bytes_text(int64_t n) {
+  return std::to_string(n) + (n == 1 ? " byte" : " bytes");
+}
+/// "1 corner", "2 corners".
+std::string corners_text(int64_t n) {
+  return std::to_string(n) + (n == 1 ? " corner" : " corners");
+}
+
 std::string record_name(const Element& el, int64_t i) {
   return el.name + " " + std::to_string(i) + " (of " + std::to_string(el.count) + ")";
 }
@@ -417,8 +429,8 @@ class BinaryBody {
     // unread would be intersections left unchecked).
     if (p_ != end_)
       throw InputError(name_, 0,
-                       std::to_string(end_ - p_) +
-                           " bytes after the last element's records; does the header count "
+                       bytes_text(end_ - p_) +
+                           " after the last element's records; does the header count "
                            "every vertex and face?",
                        offset(p_));
     reuse_.parsed_in_full(end_, mesh_);
@@ -431,8 +443,23 @@ class BinaryBody {
   [[noreturn]] void truncated(const Element& el, int64_t i, const char* at, int64_t needed) const {
     throw InputError(name_, 0,
                      "file is truncated: it ends inside " + record_name(el, i) + "; expected " +
-                         std::to_string(needed) + " more bytes, found " + std::to_string(end_ - at),
+                         std::to_string(needed) + (needed == 1 ? " more byte" : " more bytes") +
+                         ", found " + std::to_string(end_ - at),
                      offset(at));
+  }
+  /// A count the bytes left cannot hold, found before allocating for it (so that a corrupt
+  /// count cannot ask for terabytes). With fixed-size records the record the file ends inside
+  /// is known; records with lists vary in size, and only a bound is.
+  void check_count_fits(const Element& el, int64_t min_bytes) const {
+    if (min_bytes <= 0 || el.count <= (end_ - p_) / min_bytes) return;
+    const int64_t fit = (end_ - p_) / min_bytes;
+    if (!el.has_list()) truncated(el, fit, p_ + fit * min_bytes, min_bytes);
+    throw InputError(name_, 0,
+                     "file is truncated: the header declares " + std::to_string(el.count) + " " +
+                         el.name + " records, and the " + bytes_text(end_ - p_) +
+                         " after this point hold at most " + std::to_string(fit) + " (each takes " +
+                         bytes_text(min_bytes) + " or more)",
+                     offset(p_));
   }
   void need(const Element& el, int64_t i, int64_t bytes) const {
     if (end_ - p_ < bytes) truncated(el, i, p_, bytes);
@@ -485,10 +512,7 @@ class BinaryBody {
 
   void read_vertices(const Element& el) {
     const int64_t min_bytes = el.min_record_bytes();
-    // Checked before allocating, so that a corrupt count cannot ask for terabytes.
-    if (min_bytes > 0 && el.count > (end_ - p_) / min_bytes) {
-      truncated(el, (end_ - p_) / min_bytes, p_ + ((end_ - p_) / min_bytes) * min_bytes, min_bytes);
-    }
+    check_count_fits(el, min_bytes);
     mesh_.positions.resize(static_cast<size_t>(el.count));
     int offsets[3];
     Scalar types[3];
@@ -587,10 +611,7 @@ class BinaryBody {
   }
 
   void read_faces(const Element& el) {
-    const int64_t min_bytes = el.min_record_bytes();
-    if (min_bytes > 0 && el.count > (end_ - p_) / min_bytes) {
-      truncated(el, (end_ - p_) / min_bytes, p_ + ((end_ - p_) / min_bytes) * min_bytes, min_bytes);
-    }
+    check_count_fits(el, el.min_record_bytes());
     const Element& vertices = h_.elements[plan_.vertex_element];
     const int64_t vertex_count = vertices.count;
     mesh_.triangles.reserve(static_cast<size_t>(el.count));
@@ -619,10 +640,9 @@ class BinaryBody {
         need(el, i, count_size);
         const int64_t n = load_int(p_, list.count_type);
         if (n < 3) {
-          throw InputError(
-              name_, 0,
-              record_name(el, i) + " has " + std::to_string(n) + " corners; expected at least 3",
-              offset(p_));
+          throw InputError(name_, 0,
+                           record_name(el, i) + " has " + corners_text(n) + "; expected at least 3",
+                           offset(p_));
         }
         p_ += count_size;
         need(el, i, n * index_size);
@@ -695,9 +715,7 @@ class BinaryBody {
   void skip_element(const Element& el) {
     if (!el.has_list()) {
       const int64_t stride = el.min_record_bytes();
-      if (stride > 0 && el.count > (end_ - p_) / stride) {
-        truncated(el, (end_ - p_) / stride, p_ + ((end_ - p_) / stride) * stride, stride);
-      }
+      check_count_fits(el, stride);
       p_ += el.count * stride;
       return;
     }
@@ -955,7 +973,7 @@ class AsciiBody {
       }
       const int64_t n = next_integer(el, i, prop, "corner count", &count_length_);
       if (n < 3) {
-        fail(record_name(el, i) + " has " + std::to_string(n) + " corners; expected at least 3");
+        fail(record_name(el, i) + " has " + corners_text(n) + "; expected at least 3");
       }
       corners_.clear();
       for (int64_t c = 0; c < n; ++c) {

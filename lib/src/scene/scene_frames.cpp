@@ -11,6 +11,21 @@ namespace {
 
 constexpr std::string_view kDefaultGroup = "default";
 
+/// A name for a message, shortened past 40 characters (an OBJ group name can be a whole line).
+std::string shortened(const std::string& name) {
+  return name.size() <= 40 ? name : name.substr(0, 40) + "...";
+}
+
+/// Groups for a message: the first few, shortened, and how many more.
+std::string listed_groups(const std::vector<std::string>& groups) {
+  constexpr size_t kListed = 10;
+  std::string text;
+  for (size_t i = 0; i < groups.size() && i < kListed; ++i)
+    text += (i ? ", " : "") + shortened(groups[i]);
+  if (groups.size() > kListed) text += " and " + std::to_string(groups.size() - kListed) + " more";
+  return text;
+}
+
 std::string group_of(const mesh::Mesh& mesh, size_t triangle) {
   const int32_t g = mesh.triangle_group.empty() ? -1 : mesh.triangle_group[triangle];
   return g < 0 ? std::string(kDefaultGroup) : mesh.group_names[g];
@@ -59,11 +74,10 @@ void append_object(SceneFrame& frame, const mesh::Mesh& file_mesh, const ObjectS
         for (int k = 0; k < 3; ++k) local[file_mesh.triangles[t].v[k]] = 0;
       }
     if (faces.empty()) {
-      std::string known;
-      for (const std::string& g : face_groups(file_mesh)) known += (known.empty() ? "" : ", ") + g;
       throw InputError(file, 0,
-                       "has no faces in group \"" + *spec.group + "\" (object \"" + spec.name +
-                           "\"); its groups: " + known);
+                       "has no faces in group \"" + shortened(*spec.group) + "\" (object \"" +
+                           shortened(spec.name) +
+                           "\"); its groups: " + listed_groups(face_groups(file_mesh)));
     }
     int32_t next = vertex_base;
     for (size_t v = 0; v < local.size(); ++v)
@@ -207,12 +221,9 @@ Scene scene_from_groups(const std::string& sequence, const std::vector<std::stri
                         const std::vector<std::string>& obstacle_groups,
                         std::optional<double> weld) {
   for (const std::string& name : obstacle_groups)
-    if (std::find(groups.begin(), groups.end(), name) == groups.end()) {
-      std::string known;
-      for (const std::string& g : groups) known += (known.empty() ? "" : ", ") + g;
-      throw UsageError("--obstacle-group " + name + ": " + sequence +
-                       " has no such group; its groups: " + known);
-    }
+    if (std::find(groups.begin(), groups.end(), name) == groups.end())
+      throw UsageError("--obstacle-group " + shortened(name) + ": " + sequence +
+                       " has no such group; its groups: " + listed_groups(groups));
   Scene scene;
   for (const std::string& name : groups) {
     ObjectSpec object;
@@ -226,6 +237,12 @@ Scene scene_from_groups(const std::string& sequence, const std::vector<std::stri
     object.self = !obstacle;
     scene.objects.push_back(std::move(object));
   }
+  if (!groups.empty() && obstacle_groups.size() >= groups.size() &&
+      std::ranges::all_of(groups, [&](const std::string& name) {
+        return std::ranges::find(obstacle_groups, name) != obstacle_groups.end();
+      }))
+    throw UsageError("--obstacle-group names every group of " + sequence + " (" +
+                     listed_groups(groups) + "); at least one must be a cloth to check");
   for (ObjectSpec& object : scene.objects)
     if (object.role == Role::cloth)
       for (const ObjectSpec& other : scene.objects)
