@@ -51,6 +51,12 @@ TEST_F(SequenceDir, SingleFileTakesTheDigitsOfItsName) {
   EXPECT_EQ(names(resolve_sequence(at("dress.0042.obj"))), (Names{{42, "dress.0042.obj"}}));
   EXPECT_EQ(names(resolve_sequence(at("body.obj"))), (Names{{0, "body.obj"}}));
   EXPECT_EQ(resolve_sequence(at("body.obj"))[0].path, dir_ / "body.obj");
+  // Digits past 64 bits (a timestamp to the microsecond) label no frame but are no reason to
+  // refuse the file (found by fuzzing): frame 0. In a directory they are an error (below).
+  touch({"scan_20240803123456789012345.obj"});
+  EXPECT_EQ(names(resolve_sequence(at("scan_20240803123456789012345.obj"))),
+            (Names{{0, "scan_20240803123456789012345.obj"}}));
+  EXPECT_THROW(resolve_sequence(dir_.string()), InputError);
 }
 
 TEST_F(SequenceDir, DirectoryListsObjAndPlyFilesInNumericOrder) {

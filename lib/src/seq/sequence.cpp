@@ -230,7 +230,17 @@ std::vector<Frame> resolve_sequence(const std::string& sequence) {
     if (frames.empty()) throw InputError(sequence, 0, "directory has no .obj or .ply files");
     return sorted_unique(std::move(frames), sequence);
   }
-  if (fs::exists(status)) return {{frame_number_from_name(spec), spec}};
+  if (fs::exists(status)) {
+    // One file: its number only labels the reports, and a name whose digits do not fit in 64
+    // bits (a timestamp to the microsecond, say) is still a file to check: frame 0, as a name
+    // without digits. Frames of a sequence need theirs to be put in order.
+    int64_t number = 0;
+    try {
+      number = frame_number_from_name(spec);
+    } catch (const InputError&) {
+    }
+    return {{number, spec}};
+  }
 
   const fs::path dir = spec.parent_path();
   const std::string name = spec.filename().string();

@@ -35,7 +35,8 @@ std::vector<Frame> resolve_sequence(const std::string& sequence);
 
 /// The last run of decimal digits in the file's stem, 0 when there is none
 /// (`dress.0042.obj` -> 42, `cloth_ball92.ply` -> 92, `t0.ply` -> 0, `body.obj` -> 0).
-/// Throws snag::InputError when the digits do not fit in 64 bits.
+/// Throws snag::InputError when the digits do not fit in 64 bits (a sequence of one file then
+/// takes frame 0; the frames of a longer one need their numbers to be ordered).
 int64_t frame_number_from_name(const std::filesystem::path& path);
 
 /// A --frames selection: comma-separated items `N`, `FIRST-LAST` or `FIRST-LASTxSTEP` (every
