@@ -615,6 +615,32 @@ TEST(SceneSplitGroups, NothingToCheckIsAnErrorThatSaysWhy) {
       << context(all.result);
 }
 
+TEST(SceneSplitGroups, TheSummaryNamesTheFirstObjectsAndCountsTheRest) {
+  // Fourteen one-triangle groups side by side: the summary names twelve, report.json all.
+  TempDir tmp;
+  std::vector<P> vertices;
+  std::vector<Face> faces;
+  std::vector<std::string> groups;
+  for (int g = 0; g < 14; ++g) {
+    const int v = static_cast<int>(vertices.size());
+    for (const P& p : std::vector<P>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}})
+      vertices.push_back({p.x + 3.0 * g, p.y, p.z});
+    faces.push_back({v, v + 1, v + 2});
+    groups.push_back("panel" + std::to_string(g));
+  }
+  write_text(tmp.path() / "panels.obj", obj_text(vertices, faces, groups));
+  fs::remove_all(tmp.path() / "out");
+  const RunResult run =
+      run_snag({"check", "panels.obj", "--split-groups", "--out", "out"}, tmp.path());
+  ASSERT_EQ(run.status, 0) << context(run);
+  EXPECT_NE(run.out.find("panel11 (cloth"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("panel12 (cloth"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(", and 2 more (report.json)"), std::string::npos) << run.out;
+  EXPECT_EQ(
+      json::parse(read_text(tmp.path() / "out" / "report.json")).at("inputs").at("objects").size(),
+      14u);
+}
+
 // Penetration ----------------------------------------------------------------------------------
 
 /// A cloth of two triangles: (a) three vertices inside the unit cube at depths 0.5 (its
