@@ -179,16 +179,17 @@ struct RunTotals {
   double wall_seconds = 0;
 };
 
-/// A scene run's objects, one line: "dress (cloth), body (obstacle, still, closed)".
-/// The scene's objects for the summary: the first kListed of them; report.json lists them all
-/// (--split-groups on a file of hundreds of groups made this one line of tens of kilobytes).
-std::string objects_line(const std::vector<report::ObjectInput>& objects) {
+/// A scene run's objects, one line: "dress (cloth), body (obstacle, still, closed)"; the first
+/// kListed of them, then how many more (--split-groups on a file of hundreds of groups made this
+/// one line of tens of kilobytes). report.json, when written, lists them all.
+std::string objects_line(const std::vector<report::ObjectInput>& objects, bool report_written) {
   constexpr size_t kListed = 12;
   std::string line;
   for (size_t i = 0; i < objects.size(); ++i) {
     const report::ObjectInput& o = objects[i];
     if (i == kListed) {
-      line += ", and " + std::to_string(objects.size() - kListed) + " more (report.json)";
+      line += ", and " + std::to_string(objects.size() - kListed) + " more" +
+              (report_written ? " (report.json lists them)" : "");
       break;
     }
     if (!line.empty()) line += ", ";
@@ -203,7 +204,8 @@ std::string objects_line(const std::vector<report::ObjectInput>& objects) {
 void print_summary(std::ostream& out, const report::Summary& s, const RunTotals& totals,
                    const std::string& rebuild_policy, const std::string& out_dir,
                    const report::Inputs& inputs) {
-  if (inputs.scene()) out << "objects              " << objects_line(inputs.objects) << "\n";
+  if (inputs.scene())
+    out << "objects              " << objects_line(inputs.objects, !out_dir.empty()) << "\n";
   out << "frames checked       " << s.frames_checked << "\n";
   out << "frames with crossing " << s.frames_with_crossings << "\n";
   out << "worst frame          ";

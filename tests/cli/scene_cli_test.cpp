@@ -635,10 +635,14 @@ TEST(SceneSplitGroups, TheSummaryNamesTheFirstObjectsAndCountsTheRest) {
   ASSERT_EQ(run.status, 0) << context(run);
   EXPECT_NE(run.out.find("panel11 (cloth"), std::string::npos) << run.out;
   EXPECT_EQ(run.out.find("panel12 (cloth"), std::string::npos) << run.out;
-  EXPECT_NE(run.out.find(", and 2 more (report.json)"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(", and 2 more (report.json lists them)"), std::string::npos) << run.out;
   EXPECT_EQ(
       json::parse(read_text(tmp.path() / "out" / "report.json")).at("inputs").at("objects").size(),
       14u);
+  // Without --out there is no report to point to.
+  const RunResult bare = run_snag({"check", "panels.obj", "--split-groups"}, tmp.path());
+  ASSERT_EQ(bare.status, 0) << context(bare);
+  EXPECT_NE(bare.out.find(", and 2 more\n"), std::string::npos) << bare.out;
 }
 
 // Penetration ----------------------------------------------------------------------------------

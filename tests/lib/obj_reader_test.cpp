@@ -292,6 +292,8 @@ TEST(ObjReader, RejectsIndexOutOfRange) {
                   "out of range; a frame holds at most 2147483647 vertices");
   expect_rejected("v 0 0 0\nf 1 2 2147483648\n", 2,
                   "'2147483648' is out of range; a frame holds at most 2147483647 vertices");
+  expect_rejected("v 0 0 0\nf 1 2 -99999999999999999999\n", 2,
+                  "'-99999999999999999999' points before the first vertex (1 vertices listed");
   expect_rejected("f 1 2 3\n", 1, "'1' is out of range; the file has no vertex line");
 }
 
@@ -513,7 +515,8 @@ TEST(ReadMesh, MalformedFilesThroughAssimpAreInputErrorsNotCrashes) {
   // Found by fuzzing: libassimp 5.2's OFF importer hands on a face without indices when its
   // face line is missing or unreadable, and its triangulation then asserted (aborting the
   // process) or read out of bounds (a segmentation fault). Validated first, each is an error
-  // naming the file.
+  // naming the file. (A face line of 4,096 bytes or more also writes one byte past the
+  // importer's line buffer inside libassimp, before snag can see it: not snag's to mend.)
   const auto dir =
       std::filesystem::temp_directory_path() / ("snag_off_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
@@ -527,6 +530,19 @@ TEST(ReadMesh, MalformedFilesThroughAssimpAreInputErrorsNotCrashes) {
   // The counts' check keeps a small file whose counts it holds.
   std::ofstream(dir / "small.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   EXPECT_EQ(read_mesh(dir / "small.off").triangles.size(), 1u);
+  // Validation is for OFF only: assimp's refuses a scene whose camera two nodes share a name
+  // (as FBX files' lights do), though its mesh, one triangle, is sound.
+  std::ofstream(dir / "camera.gltf")
+      << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+      "nodes": [{"name": "cloth", "mesh": 0}, {"name": "cam", "camera": 0},
+                {"name": "cam", "camera": 0}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                     "min": [0, 0, 0], "max": [1, 1, 0]}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
+      "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]})";
+  EXPECT_EQ(read_mesh(dir / "camera.gltf").triangles.size(), 1u);
   for (const auto& [name, text] : cases) {
     std::ofstream(dir / name) << text;
     try {
@@ -534,6 +550,10 @@ TEST(ReadMesh, MalformedFilesThroughAssimpAreInputErrorsNotCrashes) {
       ADD_FAILURE() << name << " was read";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      if (std::string(name) == "huge_count.off")
+        EXPECT_NE(std::string(e.what()).find("its header declares 1073741823 vertices"),
+                  std::string::npos)
+            << e.what();
     }
   }
   std::filesystem::remove_all(dir);

@@ -56,7 +56,12 @@ TEST_F(SequenceDir, SingleFileTakesTheDigitsOfItsName) {
   touch({"scan_20240803123456789012345.obj"});
   EXPECT_EQ(names(resolve_sequence(at("scan_20240803123456789012345.obj"))),
             (Names{{0, "scan_20240803123456789012345.obj"}}));
-  EXPECT_THROW(resolve_sequence(dir_.string()), InputError);
+  try {
+    resolve_sequence(dir_.string());
+    ADD_FAILURE() << "a directory with that name resolved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not fit in 64 bits"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(SequenceDir, DirectoryListsObjAndPlyFilesInNumericOrder) {

@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <new>
 #include <string_view>
 
 #include "snag/error.h"
@@ -116,15 +115,20 @@ mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS);
-  // Validated first: an importer can hand the steps after it a malformed scene (an OFF file
-  // with a face line cut short or missing), on which libassimp 5.2's triangulation asserts
-  // (aborting the process) or reads out of bounds; validation turns that into an error.
+  unsigned steps =
+      aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices | aiProcess_Triangulate;
   std::string extension = path.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".off") check_off_counts(path);
-  const aiScene* scene = importer.ReadFile(
-      path.string(), aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
-                         aiProcess_JoinIdenticalVertices | aiProcess_Triangulate);
+  if (extension == ".off") {
+    check_off_counts(path);
+    // libassimp 5.2's OFF importer hands on a face without indices when a face line is missing
+    // or unreadable, and the steps inside ReadFile then asserted (aborting the process) or read
+    // out of bounds; its validation, which runs first, refuses it. Only for OFF: it checks the
+    // whole scene, and refuses files of other formats whose cameras or lights share a name
+    // (which FBX allows) though their meshes are sound.
+    steps |= aiProcess_ValidateDataStructure;
+  }
+  const aiScene* scene = importer.ReadFile(path.string(), steps);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path.string(), 0,
                      std::string("assimp cannot read the file: ") + importer.GetErrorString());

@@ -277,7 +277,13 @@ class ObjParser {
       const char* first = detail::past_plus(p_, end_);
       int64_t index = 0;
       auto [ptr, ec] = detail::parse_integer(first, end_, index);
-      if (ec == std::errc::result_out_of_range) index_past_any_count(start);
+      if (ec == std::errc::result_out_of_range) {
+        if (*first == '-')
+          fail("relative vertex index " + quote_token(start, end_) +
+               " points before the first vertex (" + std::to_string(mesh_.positions.size()) +
+               " vertices listed so far)");
+        index_past_any_count(start);
+      }
       if (ec != std::errc() || ptr == first ||
           (ptr < end_ && !is_blank_or_eol(*ptr) && *ptr != '/')) {
         fail("expected a vertex index (an integer, optionally followed by /vt/vn), found " +

@@ -13,7 +13,10 @@ constexpr std::string_view kDefaultGroup = "default";
 
 /// A name for a message, shortened past 40 characters (an OBJ group name can be a whole line).
 std::string shortened(const std::string& name) {
-  return name.size() <= 40 ? name : name.substr(0, 40) + "...";
+  if (name.size() <= 40) return name;
+  size_t cut = 40;  // not inside a UTF-8 character: back to its first byte
+  while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;
+  return name.substr(0, cut) + "...";
 }
 
 /// Groups for a message: the first few, shortened, and how many more.

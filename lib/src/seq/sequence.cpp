@@ -83,13 +83,26 @@ std::optional<FramePattern> find_frame_token(const std::string& name, const std:
   return found;
 }
 
-int64_t parse_frame_digits(std::string_view digits, const std::string& path) {
+/// The value of a run of digits; nothing when it does not fit in 64 bits.
+std::optional<int64_t> frame_digits_value(std::string_view digits) {
   int64_t v = 0;
   auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-  if (ec != std::errc() || ptr != digits.data() + digits.size()) {
-    throw InputError(path, 0, "frame number '" + std::string(digits) + "' does not fit in 64 bits");
-  }
+  if (ec != std::errc() || ptr != digits.data() + digits.size()) return std::nullopt;
   return v;
+}
+
+int64_t parse_frame_digits(std::string_view digits, const std::string& path) {
+  if (const std::optional<int64_t> v = frame_digits_value(digits)) return *v;
+  throw InputError(path, 0, "frame number '" + std::string(digits) + "' does not fit in 64 bits");
+}
+
+/// The last run of decimal digits in `stem` (empty when there is none).
+std::string_view last_digit_run(std::string_view stem) {
+  size_t end = stem.size();
+  while (end > 0 && !is_digit(stem[end - 1])) --end;
+  size_t begin = end;
+  while (begin > 0 && is_digit(stem[begin - 1])) --begin;
+  return stem.substr(begin, end - begin);
 }
 
 /// Matches `name` against the pattern; the frame number on success.
@@ -207,12 +220,8 @@ std::vector<Frame> sorted_unique(std::vector<Frame> frames, const std::string& s
 
 int64_t frame_number_from_name(const fs::path& path) {
   const std::string stem = path.stem().string();
-  size_t end = stem.size();
-  while (end > 0 && !is_digit(stem[end - 1])) --end;
-  if (end == 0) return 0;
-  size_t begin = end;
-  while (begin > 0 && is_digit(stem[begin - 1])) --begin;
-  return parse_frame_digits(std::string_view(stem).substr(begin, end - begin), path.string());
+  const std::string_view digits = last_digit_run(stem);
+  return digits.empty() ? 0 : parse_frame_digits(digits, path.string());
 }
 
 std::vector<Frame> resolve_sequence(const std::string& sequence) {
@@ -234,12 +243,9 @@ std::vector<Frame> resolve_sequence(const std::string& sequence) {
     // One file: its number only labels the reports, and a name whose digits do not fit in 64
     // bits (a timestamp to the microsecond, say) is still a file to check: frame 0, as a name
     // without digits. Frames of a sequence need theirs to be put in order.
-    int64_t number = 0;
-    try {
-      number = frame_number_from_name(spec);
-    } catch (const InputError&) {
-    }
-    return {{number, spec}};
+    const std::string stem = spec.stem().string();
+    const std::string_view digits = last_digit_run(stem);
+    return {{digits.empty() ? 0 : frame_digits_value(digits).value_or(0), spec}};
   }
 
   const fs::path dir = spec.parent_path();
