@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "snag/error.h"
@@ -508,6 +510,28 @@ TEST(ReadMesh, OtherFormatsGoThroughAssimpAndSaySo) {
   EXPECT_EQ(in_z0, 1);
   std::ofstream(dir / "junk.stl") << "this is not a mesh";
   EXPECT_THROW(read_mesh(dir / "junk.stl"), InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ReadMesh, ADeviceIsRefusedAndAPipeReadWhole) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("snag_dev_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  // /dev/zero named as a frame was read until memory ran out (found by fuzzing).
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.obj");
+  try {
+    read_mesh(dir / "zero.obj");
+    ADD_FAILURE() << "a device was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("zero.obj: is a device"), std::string::npos) << e.what();
+  }
+  // A pipe, as a shell's process substitution gives one, is still read to its end.
+  const auto fifo = dir / "frame.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; });
+  const mesh::Mesh m = read_mesh(fifo);
+  writer.join();
+  EXPECT_EQ(m.triangles.size(), 1u);
   std::filesystem::remove_all(dir);
 }
 

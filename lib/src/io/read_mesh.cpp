@@ -36,6 +36,10 @@ class OpenFile {
     if (::fstat(fd_, &st) != 0) fail("cannot stat");
     if (S_ISDIR(st.st_mode))
       throw InputError(path_.string(), 0, "is a directory; expected a mesh file");
+    // A device has no end to read to (/dev/zero, /dev/urandom) or is a terminal: found by
+    // fuzzing, /dev/zero named as a frame was read until memory ran out. Pipes are read whole.
+    if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode))
+      throw InputError(path_.string(), 0, "is a device; expected a mesh file");
     size_ = S_ISREG(st.st_mode) ? static_cast<int64_t>(st.st_size) : -1;
   }
   ~OpenFile() {
@@ -44,7 +48,7 @@ class OpenFile {
   OpenFile(const OpenFile&) = delete;
   OpenFile& operator=(const OpenFile&) = delete;
 
-  /// The size of a regular file when it was opened; -1 for a pipe or a device.
+  /// The size of a regular file when it was opened; -1 for a pipe.
   int64_t size() const { return size_; }
 
   /// Reads up to `n` bytes into `dst`, fewer only at the end of the file (a file that shrank).
@@ -69,7 +73,7 @@ class OpenFile {
   int64_t size_ = -1;
 };
 
-/// Reads a pipe or device to its end.
+/// Reads a pipe to its end.
 std::string read_stream(OpenFile& file) {
   std::string bytes;
   size_t used = 0;
