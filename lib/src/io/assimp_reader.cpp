@@ -10,6 +10,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -62,7 +63,7 @@ struct SceneFlattener {
 };
 
 /// An OFF file's declared counts against its size, before assimp reserves room for them:
-/// libassimp 5.2's OFF importer allocates what the header says (a 60-byte file declaring a
+/// libassimp 5.2's OFF importer allocates what the header says (a 45-byte file declaring a
 /// billion vertices took 12 GB, then aborted the process). Every vertex line takes at least 6
 /// bytes ("0 0 0\n"), every face line 2 ("0\n"). Headers this does not recognise (the 4OFF and
 /// nOFF variants, counts past the first 4 KB) are left to assimp.
