@@ -348,13 +348,9 @@ void add_polygon(mesh::Mesh& m, const std::vector<int32_t>& corners, int32_t pol
   }
 }
 
-/// "1 byte", "12 bytes".
-std::string bytes_text(int64_t n) {
-  return std::to_string(n) + (n == 1 ? " byte" : " bytes");
-}
-/// "1 corner", "2 corners".
-std::string corners_text(int64_t n) {
-  return std::to_string(n) + (n == 1 ? " corner" : " corners");
+/// `n` and `noun`, plural but for one: "1 byte", "12 bytes", "2 more bytes".
+std::string counted(int64_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
 std::string record_name(const Element& el, int64_t i) {
@@ -429,7 +425,7 @@ class BinaryBody {
     // unread would be intersections left unchecked).
     if (p_ != end_)
       throw InputError(name_, 0,
-                       bytes_text(end_ - p_) +
+                       counted(end_ - p_, "byte") +
                            " after the last element's records; does the header count "
                            "every vertex and face?",
                        offset(p_));
@@ -443,8 +439,7 @@ class BinaryBody {
   [[noreturn]] void truncated(const Element& el, int64_t i, const char* at, int64_t needed) const {
     throw InputError(name_, 0,
                      "file is truncated: it ends inside " + record_name(el, i) + "; expected " +
-                         std::to_string(needed) + (needed == 1 ? " more byte" : " more bytes") +
-                         ", found " + std::to_string(end_ - at),
+                         counted(needed, "more byte") + ", found " + std::to_string(end_ - at),
                      offset(at));
   }
   /// A count the bytes left cannot hold, found before allocating for it (so that a corrupt
@@ -456,9 +451,9 @@ class BinaryBody {
     if (!el.has_list()) truncated(el, fit, p_ + fit * min_bytes, min_bytes);
     throw InputError(name_, 0,
                      "file is truncated: the header declares " + std::to_string(el.count) + " " +
-                         el.name + " records, and the " + bytes_text(end_ - p_) +
+                         el.name + " records, and the " + counted(end_ - p_, "byte") +
                          " after this point hold at most " + std::to_string(fit) + " (each takes " +
-                         bytes_text(min_bytes) + " or more)",
+                         counted(min_bytes, "byte") + " or more)",
                      offset(p_));
   }
   void need(const Element& el, int64_t i, int64_t bytes) const {
@@ -640,9 +635,10 @@ class BinaryBody {
         need(el, i, count_size);
         const int64_t n = load_int(p_, list.count_type);
         if (n < 3) {
-          throw InputError(name_, 0,
-                           record_name(el, i) + " has " + corners_text(n) + "; expected at least 3",
-                           offset(p_));
+          throw InputError(
+              name_, 0,
+              record_name(el, i) + " has " + counted(n, "corner") + "; expected at least 3",
+              offset(p_));
         }
         p_ += count_size;
         need(el, i, n * index_size);
@@ -973,7 +969,7 @@ class AsciiBody {
       }
       const int64_t n = next_integer(el, i, prop, "corner count", &count_length_);
       if (n < 3) {
-        fail(record_name(el, i) + " has " + corners_text(n) + "; expected at least 3");
+        fail(record_name(el, i) + " has " + counted(n, "corner") + "; expected at least 3");
       }
       corners_.clear();
       for (int64_t c = 0; c < n; ++c) {

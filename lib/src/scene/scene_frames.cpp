@@ -240,9 +240,8 @@ Scene scene_from_groups(const std::string& sequence, const std::vector<std::stri
     object.self = !obstacle;
     scene.objects.push_back(std::move(object));
   }
-  if (!groups.empty() && obstacle_groups.size() >= groups.size() &&
-      std::ranges::all_of(groups, [&](const std::string& name) {
-        return std::ranges::find(obstacle_groups, name) != obstacle_groups.end();
+  if (!scene.objects.empty() && std::ranges::none_of(scene.objects, [](const ObjectSpec& o) {
+        return o.role == Role::cloth;
       }))
     throw UsageError("--obstacle-group names every group of " + sequence + " (" +
                      listed_groups(groups) + "); at least one must be a cloth to check");
