@@ -231,15 +231,38 @@ SmallMesh triangle_stack(int count, double rise) {
 
 TEST(CudaDetect, ResultsComeBackSortedWhateverTheLastFrameLeftExpected) {
   SNAG_REQUIRE_GPU();
-  // The results' grid is sized by the last frame's counts: a frame of none, then one of 7,140
-  // pairs (28 slices of the ranking on a grid sized for 4), then none again.
+  // The ranking's grid is sized by the last frames' counts: after 60 frames of none it is one
+  // slice by one, which then strides over the 28 slices of the next frame's 7,140 pairs, then
+  // the grid grows again.
   const SmallMesh apart = triangle_stack(120, 1.0), together = triangle_stack(120, 0.0);
   detect::Checker checker(gpu_backend(), std::make_shared<IntegerResolver>());
   checker.set_triangles(apart.triangles, static_cast<int32_t>(apart.positions.size()));
-  for (const SmallMesh* frame : {&apart, &together, &apart, &together, &together}) {
-    const detect::FrameResult result = checker.check(frame->positions);
-    EXPECT_EQ(result.pairs, brute_force(*frame));
-    EXPECT_EQ(result.pairs.size(), frame == &apart ? 0u : 120u * 119u / 2u);
+  std::vector<const SmallMesh*> frames(60, &apart);
+  frames.insert(frames.end(), {&together, &apart, &together, &together});
+  const std::vector<detect::FacePair> all = brute_force(together);
+  ASSERT_EQ(all.size(), 120u * 119u / 2u);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const detect::FrameResult result = checker.check(frames[f]->positions);
+    if (frames[f] == &apart)
+      EXPECT_TRUE(result.pairs.empty()) << "frame " << f;
+    else
+      EXPECT_EQ(result.pairs, all) << "frame " << f;
+  }
+}
+
+TEST(CudaDetect, ResultsRankedOnEitherSideOfTheRankingsLimit) {
+  SNAG_REQUIRE_GPU();
+  // Stacks of n coplanar triangles have n(n-1)/2 pairs: 1 and 3 in part of one slice of the
+  // ranking, 4,095 and 4,186, 8,128 under its limit (8,192) and 8,256 past it, where CUB's sort
+  // takes over, then 4,095 again. Each size from a fresh backend and after the others.
+  detect::Checker reused(gpu_backend(), std::make_shared<IntegerResolver>());
+  for (int n : {2, 3, 91, 92, 128, 129, 91}) {
+    const SmallMesh stack = triangle_stack(n, 0.0);
+    const std::vector<detect::FacePair> expected = brute_force(stack);
+    ASSERT_EQ(expected.size(), static_cast<size_t>(n) * (n - 1) / 2);
+    EXPECT_EQ(check_on_gpu(stack).pairs, expected) << n << " triangles";
+    reused.set_triangles(stack.triangles, static_cast<int32_t>(stack.positions.size()));
+    EXPECT_EQ(reused.check(stack.positions).pairs, expected) << n << " triangles, reused";
   }
 }
 
