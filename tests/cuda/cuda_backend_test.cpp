@@ -252,9 +252,10 @@ TEST(CudaDetect, ResultsComeBackSortedWhateverTheLastFrameLeftExpected) {
 
 TEST(CudaDetect, ResultsRankedOnEitherSideOfTheRankingsLimit) {
   SNAG_REQUIRE_GPU();
-  // Stacks of n coplanar triangles have n(n-1)/2 pairs: 1 and 3 in part of one slice of the
-  // ranking, 4,095 and 4,186, 8,128 under its limit (8,192) and 8,256 past it, where CUB's sort
-  // takes over, then 4,095 again. Each size from a fresh backend and after the others.
+  // Stacks of n coplanar triangles have n(n-1)/2 pairs: 1 and 3 in part of one 256-key slice
+  // of the ranking, 4,095 (16 slices, the last one short) and 4,186 (a 17th begun), 8,128 under
+  // its limit (8,192) and 8,256 past it, where CUB's sort takes over, then 4,095 again. Each
+  // size from a fresh backend and after the others.
   detect::Checker reused(gpu_backend(), std::make_shared<IntegerResolver>());
   for (int n : {2, 3, 91, 92, 128, 129, 91}) {
     const SmallMesh stack = triangle_stack(n, 0.0);
