@@ -82,10 +82,14 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
           box_of(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
     }
   };
+  // Lambdas, not the functions themselves: each has a type of its own, so each loop is compiled
+  // with its box inlined. Both functions have one type, so passing them shared one loop that
+  // called the box through a pointer, leaf by leaf (a 36K frame's refit 0.30 -> 0.69 ms).
   if (leaf_boxes_ == LeafBoxes::skip_collapsed)
-    fit_leaves(leaf_box);
+    fit_leaves([](geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) { return leaf_box(a, b, c); });
   else
-    fit_leaves(geom::triangle_box);
+    fit_leaves(
+        [](geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) { return geom::triangle_box(a, b, c); });
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to
   // gain from threads run on one, without a barrier: barriers are what costs when the machine
