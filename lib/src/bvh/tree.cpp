@@ -75,12 +75,17 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   // Leaves in triangle order: the corners are read in file order (mostly sequential) and
   // only the box writes scatter, where leaf order would scatter every read.
   auto fit_leaves = [&](auto&& box_of) {
-#pragma omp parallel for num_threads(threads) schedule(static) if (n > kParallelLevel)
-    for (int32_t t = 0; t < n; ++t) {
+    auto fit = [&](int32_t t) {
       const geom::Tri tri = mesh.triangles[t];
       tree.boxes[leaf_of_triangle_[t]] =
           box_of(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
+    };
+    if (n <= kParallelLevel) {
+      for (int32_t t = 0; t < n; ++t) fit(t);
+      return;
     }
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int32_t t = 0; t < n; ++t) fit(t);
   };
   // Lambdas, not the functions themselves: each has a type of its own, so each loop is compiled
   // with its box inlined. Both functions have one type, so passing them shared one loop that
@@ -91,13 +96,23 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
     fit_leaves(
         [](geom::Vec3d a, geom::Vec3d b, geom::Vec3d c) { return geom::triangle_box(a, b, c); });
   // One level at a time from the deepest internal level up, each level in parallel; the end
-  // of each loop orders a level's writes before its parents read them. Levels too small to
-  // gain from threads run on one, without a barrier: barriers are what costs when the machine
-  // is shared and threads get descheduled.
+  // of each loop orders a level's writes before its parents read them. Levels too small to gain
+  // from threads run on one, without a barrier or a parallel region (barriers are what costs
+  // when the machine is shared and threads get descheduled, and even a region of one thread
+  // costs about a microsecond); once every node left is on such levels, they all run in one
+  // loop down the node ids, children always coming after their parent.
   for (int32_t level = shape_.depth - 1; level >= 0; --level) {
     int32_t first, last;
     internal_nodes_of_level(shape_, level, first, last);
-#pragma omp parallel for num_threads(threads) schedule(static) if (last - first > kParallelLevel)
+    if (last <= kParallelLevel) {
+      for (int32_t node = last - 1; node >= 0; --node) refit_internal(node, tree);
+      break;
+    }
+    if (last - first <= kParallelLevel) {
+      for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
+      continue;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
   }
 }
