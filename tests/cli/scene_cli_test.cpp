@@ -592,6 +592,32 @@ TEST(SceneSplitGroups, ObstacleGroupIsNotCheckedAgainstItself) {
   EXPECT_EQ(object_in(cloth.report.at("inputs").at("objects"), "body").at("role"), "cloth");
 }
 
+TEST(SceneSplitGroups, FacesOfNoGroupAndOfAGroupNamedDefaultAreOneObject) {
+  // The post (face 0) before any group line, the bar (face 1) in a group named "default", the
+  // sheet (faces 2 and 3) in group shirt: faces of no group are in "default" too, so the post
+  // and the bar are one object, checked against itself (they cross) and against the shirt.
+  TempDir tmp;
+  std::string text =
+      obj_text(joined(joined(post(0.5), bar), sheet), {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}, {6, 8, 9}});
+  const size_t second_face = text.find("f 4 5 6\n"), third_face = text.find("f 7 8 9\n");
+  ASSERT_NE(second_face, std::string::npos);
+  ASSERT_NE(third_face, std::string::npos);
+  text.insert(third_face, "g shirt\n");
+  text.insert(second_face, "g default\n");
+  write_text(tmp.path() / "avatar.obj", text);
+
+  const SceneRun run = run_in(tmp.path(), {"avatar.obj", "--split-groups"});
+  ASSERT_EQ(run.result.status, 1) << context(run.result);
+  EXPECT_EQ(run.pairs_csv,
+            "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n"
+            "0,0,1,crossing,0,1,default,default\n"
+            "0,0,2,crossing,0,2,default,shirt\n");
+  const json& objects = run.report.at("inputs").at("objects");
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0].at("group"), "default");
+  EXPECT_EQ(objects[1].at("group"), "shirt");
+}
+
 TEST(SceneSplitGroups, NothingToCheckIsAnErrorThatSaysWhy) {
   // Found by fuzzing: both were the usage error "a scene needs at least one cloth", naming
   // neither the file nor the options.

@@ -68,14 +68,22 @@ void append_object(SceneFrame& frame, const mesh::Mesh& file_mesh, const ObjectS
       frame.file_triangle.push_back(static_cast<int32_t>(t));
     }
   } else {
-    // The group's faces, and the vertices they use renumbered in file order.
+    // The group's faces, and the vertices they use renumbered in file order. Which of the
+    // file's groups are the object's is decided once per group, not once per face (a name
+    // compared per face was a string built per face, every frame): faces of no group are in
+    // "default", and so are those of a group of that name.
+    std::vector<uint8_t> wanted(file_mesh.group_names.size());
+    for (size_t g = 0; g < wanted.size(); ++g) wanted[g] = file_mesh.group_names[g] == *spec.group;
+    const bool wanted_ungrouped = *spec.group == kDefaultGroup;
     std::vector<int32_t> local(file_mesh.positions.size(), -1);
     std::vector<size_t> faces;
-    for (size_t t = 0; t < triangles; ++t)
-      if (group_of(file_mesh, t) == *spec.group) {
+    for (size_t t = 0; t < triangles; ++t) {
+      const int32_t g = file_mesh.triangle_group.empty() ? -1 : file_mesh.triangle_group[t];
+      if (g < 0 ? wanted_ungrouped : wanted[g] != 0) {
         faces.push_back(t);
         for (int k = 0; k < 3; ++k) local[file_mesh.triangles[t].v[k]] = 0;
       }
+    }
     if (faces.empty()) {
       throw InputError(file, 0,
                        "has no faces in group \"" + shortened(*spec.group) + "\" (object \"" +
