@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "snag/threads.h"
+
 namespace snag::bvh {
 
 namespace {
@@ -75,17 +77,11 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   // Leaves in triangle order: the corners are read in file order (mostly sequential) and
   // only the box writes scatter, where leaf order would scatter every read.
   auto fit_leaves = [&](auto&& box_of) {
-    auto fit = [&](int32_t t) {
+    for_each_index(threads, n, kParallelLevel, [&](int64_t t) {
       const geom::Tri tri = mesh.triangles[t];
       tree.boxes[leaf_of_triangle_[t]] =
           box_of(mesh.positions[tri.v[0]], mesh.positions[tri.v[1]], mesh.positions[tri.v[2]]);
-    };
-    if (n <= kParallelLevel) {
-      for (int32_t t = 0; t < n; ++t) fit(t);
-      return;
-    }
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (int32_t t = 0; t < n; ++t) fit(t);
+    });
   };
   // Lambdas, not the functions themselves: each has a type of its own, so each loop is compiled
   // with its box inlined. Both functions have one type, so passing them shared one loop that
@@ -98,9 +94,9 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to gain
   // from threads run on one, without a barrier or a parallel region (barriers are what costs
-  // when the machine is shared and threads get descheduled, and even a region of one thread
-  // costs about a microsecond); once every node left is on such levels, they all run in one
-  // loop down the node ids, children always coming after their parent.
+  // when the machine is shared and threads get descheduled); once every node left is on such
+  // levels, they all run in one loop down the node ids, children always coming after their
+  // parent.
   for (int32_t level = shape_.depth - 1; level >= 0; --level) {
     int32_t first, last;
     internal_nodes_of_level(shape_, level, first, last);
@@ -108,12 +104,8 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
       for (int32_t node = last - 1; node >= 0; --node) refit_internal(node, tree);
       break;
     }
-    if (last - first <= kParallelLevel) {
-      for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
-      continue;
-    }
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (int32_t node = first; node < last; ++node) refit_internal(node, tree);
+    for_each_index(threads, last - first, kParallelLevel,
+                   [&](int64_t i) { refit_internal(first + static_cast<int32_t>(i), tree); });
   }
 }
 
@@ -121,10 +113,9 @@ double Tree::quality(int threads) const {
   const int32_t blocks = quality_block_count(shape_);
   if (blocks == 0) return 0.0;
   std::vector<double> block_sums(static_cast<size_t>(blocks));
-#pragma omp parallel for num_threads(threads) \
-    schedule(static) if (blocks > kParallelLevel / kQualityBlock)
-  for (int32_t block = 0; block < blocks; ++block)
-    block_sums[block] = quality_block_sum(boxes_.data(), shape_, block);
+  for_each_index(threads, blocks, kParallelLevel / kQualityBlock, [&](int64_t block) {
+    block_sums[block] = quality_block_sum(boxes_.data(), shape_, static_cast<int32_t>(block));
+  });
   return quality_from_blocks(block_sums.data(), blocks, boxes_[0]);
 }
 

@@ -197,10 +197,8 @@ int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& t
                        const geom::PlaneCoefficients* planes) {
   certain.assign(pairs.size(), 1);
   const geom::FilteredPredicates pred{positions.data()};
-  int64_t uncertain = 0;
   const auto count = static_cast<int64_t>(pairs.size());
-#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : uncertain) if (count > 512)
-  for (int64_t i = 0; i < count; ++i) {
+  for_each_index(threads, count, 512, [&](int64_t i) {
     // A pair's data is scattered (its second triangle anywhere in the mesh): its test waited on
     // a dozen cache misses, one after another. Ahead of time, the triangles of the pair 16 on,
     // then the planes and corners of the pair 8 on (its triangles by then in cache).
@@ -230,14 +228,12 @@ int64_t classify_pairs(std::span<const geom::Vec3d> positions, const Topology& t
     } else {
       crossing = geom::is_crossing(pred, f, x);
     }
-    if (crossing == geom::Answer::uncertain) {
+    if (crossing == geom::Answer::uncertain)
       certain[i] = 0;
-      ++uncertain;
-    } else {
+    else
       pair.kind = crossing == geom::Answer::yes ? PairKind::crossing : PairKind::touching;
-    }
-  }
-  return uncertain;
+  });
+  return std::count(certain.begin(), certain.end(), uint8_t{0});
 }
 
 }  // namespace snag::detect

@@ -365,15 +365,13 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
   vertex_normal_.resize(positions_.size());
   const geom::Vec3d* p = positions_.data();
   const geom::Tri* tris = triangles_.data();
-#pragma omp parallel for num_threads(threads) schedule(static) if (n > 4096)
-  for (int32_t t = 0; t < n; ++t) {
+  for_each_index(threads, n, 4096, [&](int64_t t) {
     const geom::Tri tri = tris[t];
     face_normal_[t] =
         unit_or_zero(geom::cross(p[tri.v[1]] - p[tri.v[0]], p[tri.v[2]] - p[tri.v[0]]));
-  }
+  });
   // Gathered per vertex (no scatter, no atomics): the same sums for every thread count.
-#pragma omp parallel for num_threads(threads) schedule(static) if (vertex_count_ > 4096)
-  for (int32_t v = 0; v < vertex_count_; ++v) {
+  for_each_index(threads, vertex_count_, 4096, [&](int64_t v) {
     geom::Vec3d sum{0.0, 0.0, 0.0};
     for (int32_t i = corner_begin_[v]; i < corner_begin_[v + 1]; ++i) {
       const int32_t t = corners_[i] / 3, k = corners_[i] % 3;
@@ -384,7 +382,7 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
       sum = sum + angle * face_normal_[t];
     }
     vertex_normal_[v] = sum;
-  }
+  });
   // In triangle order on one thread, so that the sum is the same for every thread count.
   double six_volume = 0.0;
   for (int32_t t = 0; t < n; ++t) {
