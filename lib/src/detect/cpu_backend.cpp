@@ -21,6 +21,13 @@ namespace snag::detect {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// A part's per-triangle and per-vertex loops (the degenerate scan, planes, fans) run on the
+/// calling thread up to this many items (for_each_index): a small object of a scene then costs
+/// no parallel region, each about a microsecond, and a fan's ~55 ns (the dearest item) times
+/// 256 is still short.
+constexpr int64_t kSerialItems = 256;
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -226,12 +233,10 @@ class CpuBackend final : public Backend {
       const int32_t begin = topology_->layout.triangle_begin[part];
       const int32_t end = topology_->layout.triangle_begin[part + 1];
       std::vector<uint8_t> answer(static_cast<size_t>(end - begin));
-#pragma omp parallel for num_threads(threads_) schedule(static)
-      for (int32_t t = begin; t < end; ++t) {
-        const geom::Tri tri = topology_->triangles[t];
-        answer[t - begin] =
-            static_cast<uint8_t>(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
-      }
+      for_each_index(threads_, end - begin, kSerialItems, [&](int64_t i) {
+        const geom::Tri tri = topology_->triangles[begin + i];
+        answer[i] = static_cast<uint8_t>(geom::is_degenerate(pred, tri.v[0], tri.v[1], tri.v[2]));
+      });
       for (int32_t t = begin; t < end; ++t) {
         if (answer[t - begin] == static_cast<uint8_t>(geom::Answer::yes))
           scan.degenerate.push_back(t);
@@ -296,9 +301,9 @@ class CpuBackend final : public Backend {
         if (!needed[part]) continue;
         const int32_t begin = topo.layout.triangle_begin[part];
         const int32_t end = topo.layout.triangle_begin[part + 1];
-#pragma omp parallel for num_threads(threads_) schedule(static)
-        for (int32_t t = begin; t < end; ++t)
-          planes_[t] = triangle_plane(positions_.data(), topo.triangles[t]);
+        for_each_index(threads_, end - begin, kSerialItems, [&](int64_t i) {
+          planes_[begin + i] = triangle_plane(positions_.data(), topo.triangles[begin + i]);
+        });
       }
     }
     // The fans of the parts checked against themselves: their pairs' tests read them.
@@ -310,9 +315,10 @@ class CpuBackend final : public Backend {
         const int32_t part = topo.checks[c].a;
         const int32_t begin = topo.layout.vertex_begin[part];
         const int32_t end = topo.layout.vertex_begin[part + 1];
-#pragma omp parallel for num_threads(threads_) schedule(static)
-        for (int32_t v = begin; v < end; ++v)
+        for_each_index(threads_, end - begin, kSerialItems, [&](int64_t i) {
+          const auto v = static_cast<int32_t>(begin + i);
           fan_clear_[v] = fan_is_clear(positions_.data(), planes_.data(), fans, v) ? 1 : 0;
+        });
       }
     }
     const FrameView frame_view{positions_.data(), planes_.data(),
@@ -418,6 +424,10 @@ class CpuBackend final : public Backend {
       return topo.layout.triangle_begin[p + 1] - topo.layout.triangle_begin[p];
     };
     if (size(a) == 0 || size(b) == 0) return;
+    // Parts whose trees' roots are apart (most pairs of a scene of many objects) have no
+    // candidate: every walk would stop at the other root. Left out before the parallel region
+    // they would each open.
+    if (!geom::overlap(trees_[a].boxes()[0], trees_[b].boxes()[0])) return;
     if (size(a) < size(b)) std::swap(a, b);
     const WalkInput in{trees_[a].view(),
                        topo.layout.triangle_begin[a],
