@@ -9,8 +9,8 @@ namespace snag::bvh {
 
 namespace {
 
-/// Levels with fewer nodes than this are refit on one thread: splitting them costs more than
-/// it saves.
+/// Loops of at most this many leaves or nodes (and the quality's blocks of as many) run on one
+/// thread (for_each_index): splitting them costs more than it saves.
 constexpr int32_t kParallelLevel = 4096;
 
 /// The internal nodes of `level`: [first, last).
@@ -94,9 +94,9 @@ void Tree::refit(mesh::MeshView mesh, int threads) {
   // One level at a time from the deepest internal level up, each level in parallel; the end
   // of each loop orders a level's writes before its parents read them. Levels too small to gain
   // from threads run on one, without a barrier or a parallel region (barriers are what costs
-  // when the machine is shared and threads get descheduled); once every node left is on such
-  // levels, they all run in one loop down the node ids, children always coming after their
-  // parent.
+  // when the machine is shared and threads get descheduled); once at most kParallelLevel
+  // internal nodes are left (the levels from the root down to this one), they all run in one
+  // loop down the node ids, children always coming after their parent.
   for (int32_t level = shape_.depth - 1; level >= 0; --level) {
     int32_t first, last;
     internal_nodes_of_level(shape_, level, first, last);

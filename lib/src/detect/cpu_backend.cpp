@@ -35,20 +35,13 @@ double seconds_since(Clock::time_point start) {
 /// Per-thread results: no lock per appended result; merged after the parallel loop. Each on
 /// cache lines of its own: a thread counts every candidate and miss in its sink, and sinks side
 /// by side put one thread's counters on the line of the next one's vectors, which it writes at
-/// every hit. Kept by the backend from frame to frame, so that the vectors keep their room.
+/// every hit.
 struct alignas(64) ThreadSink {
   std::vector<EdgeTriangleTask> hits;
   std::vector<EdgeTriangleTask> uncertain_tests;
   std::vector<FacePair> duplicates;
   int64_t misses = 0;
   int64_t candidates = 0;
-
-  void clear() {
-    hits.clear();
-    uncertain_tests.clear();
-    duplicates.clear();
-    misses = candidates = 0;
-  }
 
   void hit(int32_t edge, int32_t triangle) { hits.push_back({edge, triangle}); }
   void uncertain(int32_t edge, int32_t triangle) { uncertain_tests.push_back({edge, triangle}); }
@@ -334,9 +327,7 @@ class CpuBackend final : public Backend {
     const FrameView frame_view{positions_.data(), planes_.data(),
                                use == FilterUse::certify ? fan_clear_.data() : nullptr};
 
-    std::vector<ThreadSink>& sinks = sinks_;
-    sinks.resize(static_cast<size_t>(threads_));
-    for (ThreadSink& sink : sinks) sink.clear();
+    std::vector<ThreadSink> sinks(static_cast<size_t>(threads_));
     for (int32_t c : checks) {
       const auto check_start = Clock::now();
       const PartCheck check = topo.checks[c];
@@ -504,7 +495,6 @@ class CpuBackend final : public Backend {
   std::span<const geom::Vec3d> positions_;
   std::vector<geom::PlaneCoefficients> planes_;  ///< per triangle, this frame
   std::vector<uint8_t> fan_clear_;               ///< per vertex, this frame: fan_is_clear
-  std::vector<ThreadSink> sinks_;                ///< per thread, emptied at each detect
   std::vector<bvh::Tree> trees_;                 ///< per part
 };
 

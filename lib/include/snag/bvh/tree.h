@@ -299,7 +299,8 @@ class Tree {
   /// for every thread count. Then refits.
   void build(mesh::MeshView mesh, int threads);
   /// Recomputes every box from the current positions, leaves first, then one level at a
-  /// time up to the root, each level in parallel.
+  /// time up to the root, each large level in parallel (the top levels' few thousand nodes in
+  /// one loop on the calling thread).
   void refit(mesh::MeshView mesh, int threads);
   /// Sum of internal-node half areas over the root's half area (0 for a single leaf), summed
   /// in the blocked order of quality_block_sum / quality_from_blocks, so the same bits for
