@@ -520,6 +520,12 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
                         " objects");
   std::vector<Meter> meters;
   bool any_assimp = false;
+  // Group names are compared per reported pair only when some object has ignore rules.
+  const bool any_ignore_rules =
+      std::any_of(scene.objects.begin(), scene.objects.end(),
+                  [](const scene::ResolvedObject& o) { return !o.spec.ignore.empty(); });
+  // A scene report's check of each (object, object): its index in the frame's checks, or -1.
+  std::vector<int32_t> check_of;
   // A run of this checker cut short by an error may have left its next frame staged, in memory
   // given back since (a staging buffer, a frame's vector) that this run's frames may reuse.
   checker.forget_next_frame();
@@ -611,15 +617,19 @@ void check_scene(const scene::ResolvedScene& scene, detect::Checker& checker,
         return g < 0 ? std::string("default") : mesh.group_names[g];
       };
       std::vector<report::CheckFrame> checks;
-      for (const detect::CheckOutcome& c : result.checks)
+      check_of.assign(static_cast<size_t>(object_count) * static_cast<size_t>(object_count), -1);
+      for (const detect::CheckOutcome& c : result.checks) {
+        check_of[static_cast<size_t>(c.part_a) * object_count + c.part_b] =
+            static_cast<int32_t>(checks.size());
         checks.push_back({c.part_a, c.part_b, 0, c.reused, c.seconds});
+      }
       for (const detect::FacePair& p : result.pairs) {
         const int32_t oa = layout.part_of(p.a), ob = layout.part_of(p.b);
-        if (ignored(scene, oa, group_name(p.a), ob, group_name(p.b))) continue;
+        if (any_ignore_rules && ignored(scene, oa, group_name(p.a), ob, group_name(p.b))) continue;
         record.pairs.push_back({file_id(p.a), file_id(p.b), p.kind, mesh.source_polygon[p.a],
                                 mesh.source_polygon[p.b], oa, ob});
-        for (report::CheckFrame& c : checks)
-          if (c.object_a == oa && c.object_b == ob) ++c.pairs;
+        if (const int32_t c = check_of[static_cast<size_t>(oa) * object_count + ob]; c >= 0)
+          ++checks[c].pairs;
       }
       std::sort(record.pairs.begin(), record.pairs.end(), report::pair_order);
       for (int32_t t : result.degenerate)
