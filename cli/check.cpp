@@ -370,6 +370,17 @@ int run_check(const CheckOptions& o) {
     warn("--frames " + o.frames + " names frames the sequence does not have (" + runs +
          "); they are not checked");
   }
+  if (!resolved.gaps.runs.empty()) {
+    // A frame lost from a cache (a failed write, a partial copy) would otherwise pass unseen.
+    const seq::FrameGaps& gaps = resolved.gaps;
+    std::string runs;
+    for (const std::string& run : gaps.runs) runs += (runs.empty() ? "" : ", ") + run;
+    if (gaps.runs.size() == scene::ResolvedScene::kMostAbsentRuns) runs += ", ...";
+    const std::string grid = gaps.step == 1 ? "" : ", counting by " + std::to_string(gaps.step);
+    warn("the sequence skips frame numbers " + runs + " (between its first frame, " +
+         std::to_string(gaps.first) + ", and its last, " + std::to_string(gaps.last) + grid +
+         "); only the frames present are checked");
+  }
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
   // once rather than after an hour of checking.

@@ -152,8 +152,9 @@ TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
   EXPECT_NE(r.err.find("[3/3] frame 3: clean"), std::string::npos) << r.err;
 }
 
-// --frames naming frames the sequence lacks (a cache with a frame missing, or cut short):
-// the frames there are checked, and a warning names the ones that are not; a broken link
+// --frames naming frames the sequence lacks (a cache with a frame missing, or cut short), or a
+// sequence that skips a number: the frames there are checked, and a warning names the ones
+// that are not; a broken link
 // among the frames is an input error naming it.
 TEST(CliCheck, FramesTheSequenceLacksAreNamed) {
   TempDir tmp;
@@ -169,6 +170,14 @@ TEST(CliCheck, FramesTheSequenceLacksAreNamed) {
   EXPECT_EQ(quiet.err.find("warning"), std::string::npos) << quiet.err;
   const RunResult whole = run_snag({"check", "seq", "--frames", "1-4"}, tmp.path());
   EXPECT_NE(whole.err.find("does not have (2);"), std::string::npos) << whole.err;
+  // Without --frames, the numbers the sequence skips are named all the same.
+  const RunResult plain = run_snag({"check", "seq"}, tmp.path());
+  EXPECT_EQ(plain.status, 1) << context(plain);
+  EXPECT_NE(plain.err.find("warning: the sequence skips frame numbers 2 (between its first "
+                           "frame, 1, and its last, 4); only the frames present are checked"),
+            std::string::npos)
+      << plain.err;
+  EXPECT_EQ(whole.err.find("skips"), std::string::npos) << whole.err;
 
   fs::create_symlink(seq / "gone.obj", seq / "f.0005.obj");
   const RunResult broken = run_snag({"check", "seq", "--out", "r"}, tmp.path());

@@ -175,6 +175,54 @@ TEST_F(SequenceDir, NothingMatchedNamesThePattern) {
   EXPECT_THROW(resolve_sequence((dir_ / "missing_dir" / "f.%04d.obj").string()), InputError);
 }
 
+// A rest pose or a stray export beside a cache would be frame 0, checked first, and set the
+// topology of every frame after it.
+TEST_F(SequenceDir, AFileWithoutDigitsAmongFramesIsAnError) {
+  touch({"a.0001.obj", "a.0002.obj", "rest.obj"});
+  for (const std::string& spec : {dir_.string(), at("*.obj")}) {
+    try {
+      resolve_sequence(spec);
+      ADD_FAILURE() << spec << " resolved";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.path(), spec);
+      EXPECT_NE(std::string(e.what()).find("rest.obj' has no digits in its name"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // A pattern names only numbered files; a glob may leave it out.
+  const Names numbered{{1, "a.0001.obj"}, {2, "a.0002.obj"}};
+  EXPECT_EQ(names(resolve_sequence(at("a.%04d.obj"))), numbered);
+  EXPECT_EQ(names(resolve_sequence(at("a.*.obj"))), numbered);
+  // Alone it is frame 0, in a directory as on its own.
+  fs::create_directories(dir_ / "alone");
+  std::ofstream(dir_ / "alone" / "body.obj") << "v 0 0 0\n";
+  EXPECT_EQ(names(resolve_sequence((dir_ / "alone").string())), (Names{{0, "body.obj"}}));
+}
+
+TEST_F(SequenceDir, APatternMatchingNothingNamesAFileOfAnotherWidth) {
+  touch({"drape.0001.obj", "drape.0002.obj", "coat.12.obj", "other.0001.ply"});
+  const auto message = [&](const std::string& spec) -> std::string {
+    try {
+      resolve_sequence(at(spec));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "resolved";
+  };
+  EXPECT_NE(message("drape.@.obj").find("'drape.0001.obj' has its frame number padded to 4 "
+                                        "digits: write %04d, #### or $F4"),
+            std::string::npos)
+      << message("drape.@.obj");
+  EXPECT_NE(message("coat.%04d.obj").find("'coat.12.obj' has its frame number unpadded: write "
+                                          "%d, # or $F"),
+            std::string::npos)
+      << message("coat.%04d.obj");
+  // No file of that prefix and suffix: no hint.
+  EXPECT_EQ(message("hat.%04d.obj").find("has its frame number"), std::string::npos);
+  EXPECT_EQ(message("other.@@.obj").find("has its frame number"), std::string::npos);
+}
+
 TEST_F(SequenceDir, BadPatternsAreUsageErrors) {
   EXPECT_THROW(resolve_sequence(""), UsageError);
   EXPECT_THROW(resolve_sequence(at("a.%04d.%04d.obj")), UsageError);
@@ -345,6 +393,77 @@ TEST(AbsentRuns, AgreeWithEnumeratingEveryNumber) {
       for (int64_t n = -20; n <= 80; ++n)
         if (as_item.contains(n) && std::find(got.begin(), got.end(), n) == got.end())
           got.push_back(n);
+    }
+    EXPECT_EQ(got, expected);
+  }
+}
+
+TEST(FrameGaps, NamesTheNumbersMissingOnTheSequencesOwnGrid) {
+  const auto frames_of = [](std::initializer_list<int64_t> numbers) {
+    std::vector<Frame> frames;
+    for (int64_t n : numbers) frames.push_back({n, "f"});
+    return frames;
+  };
+  using Runs = std::vector<std::string>;
+  FrameGaps gaps = frame_gaps(frames_of({1, 2, 3, 5, 8, 10, 12}), 6);
+  EXPECT_EQ(gaps.runs, (Runs{"4", "6-7", "9", "11"}));
+  EXPECT_EQ(gaps.step, 1);
+  EXPECT_EQ(gaps.first, 1);
+  EXPECT_EQ(gaps.last, 12);
+  // Every 5th frame written: no gap, until one of them is lost.
+  EXPECT_EQ(frame_gaps(frames_of({1, 6, 11, 16, 21}), 6).runs, Runs{});
+  gaps = frame_gaps(frames_of({1, 6, 11, 31}), 6);
+  EXPECT_EQ(gaps.runs, (Runs{"16-26x5"}));
+  EXPECT_EQ(gaps.step, 5);
+  EXPECT_EQ(frame_gaps(frames_of({-5, -3, 3}), 6).runs, (Runs{"-1-1x2"}));
+  EXPECT_EQ(frame_gaps(frames_of({1, 2, 4, 6, 8, 10, 12, 14}), 2).runs, (Runs{"3", "5"}));
+  // Two frames, or one, make their own grid.
+  EXPECT_EQ(frame_gaps(frames_of({1, 100}), 6).runs, Runs{});
+  EXPECT_EQ(frame_gaps(frames_of({7}), 6).runs, Runs{});
+  EXPECT_EQ(frame_gaps({}, 6).runs, Runs{});
+  // The ends of int64.
+  const int64_t most = std::numeric_limits<int64_t>::max();
+  const int64_t least = std::numeric_limits<int64_t>::min();
+  EXPECT_EQ(frame_gaps(frames_of({least, 0, most}), 6).runs,
+            (Runs{std::to_string(least + 1) + "-" + std::to_string(-1),
+                  "1-" + std::to_string(most - 1)}));
+}
+
+// frame_gaps against enumerating: the step is the largest that divides every difference, and the
+// runs, expanded, are the numbers on that grid between the first and last frame that no frame has.
+TEST(FrameGaps, AgreeWithEnumeratingEveryNumber) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int64_t spacing = 1 + static_cast<int64_t>(rng() % 4);
+    const int64_t offset = static_cast<int64_t>(rng() % 7) - 3;
+    std::vector<Frame> frames;
+    for (int64_t k = -4; k <= 20; ++k)
+      if (rng() % 3 != 0) frames.push_back({offset + k * spacing, "f"});
+    if (frames.size() < 3) continue;
+    std::string listed;
+    for (const Frame& f : frames) listed += std::to_string(f.number) + " ";
+    SCOPED_TRACE(listed);
+    int64_t step = 0;
+    for (int64_t d = frames.back().number - frames.front().number; d >= 1; --d) {
+      const bool divides = std::all_of(frames.begin() + 1, frames.end(), [&](const Frame& f) {
+        return (f.number - frames.front().number) % d == 0;
+      });
+      if (divides) {
+        step = d;
+        break;
+      }
+    }
+    std::vector<int64_t> expected;
+    for (int64_t n = frames.front().number; n <= frames.back().number; n += step)
+      if (std::none_of(frames.begin(), frames.end(), [&](const Frame& f) { return f.number == n; }))
+        expected.push_back(n);
+    const FrameGaps gaps = frame_gaps(frames, 1000);
+    EXPECT_EQ(gaps.step, step);
+    std::vector<int64_t> got;
+    for (const std::string& run : gaps.runs) {
+      const FrameSelection as_item = FrameSelection::parse(run);
+      for (int64_t n = -100; n <= 100; ++n)
+        if (as_item.contains(n)) got.push_back(n);
     }
     EXPECT_EQ(got, expected);
   }

@@ -134,6 +134,8 @@ ResolvedScene resolve_scene(const Scene& scene, std::string_view frame_selection
     const seq::FrameSelection selection = seq::FrameSelection::parse(frame_selection);
     resolved.absent_frames = selection.absent_runs(resolved.frames, ResolvedScene::kMostAbsentRuns);
     resolved.frames = seq::select_frames(resolved.frames, selection);
+  } else {
+    resolved.gaps = seq::frame_gaps(resolved.frames, ResolvedScene::kMostAbsentRuns);
   }
   for (size_t i = 0; i < resolved.objects.size(); ++i) {
     ResolvedObject& object = resolved.objects[i];

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <numeric>
 #include <optional>
 #include <system_error>
 
@@ -66,7 +67,8 @@ std::optional<FramePattern> find_frame_token(const std::string& name, const std:
     if (found) {
       throw UsageError(
           "sequence pattern '" + sequence +
-          "' has more than one frame token; expected one of %04d, %d, ####, @, $F4 or $F");
+          "' has more than one frame token; expected one of %04d, %d, ####, @, $F4 or $F (a "
+          "glob such as hat#2.*.obj matches names that hold #, @, % or $F themselves)");
     }
     found = FramePattern{name.substr(0, start), name.substr(stop), std::max(width, 1)};
     i = stop;
@@ -76,7 +78,8 @@ std::optional<FramePattern> find_frame_token(const std::string& name, const std:
     for (const std::string* part : {&found->prefix, &found->suffix}) {
       if (part->find_first_of("*?[") != std::string::npos) {
         throw UsageError("sequence pattern '" + sequence +
-                         "' mixes a frame token with glob characters; use one or the other");
+                         "' mixes a frame token with glob characters; use one or the other (in "
+                         "a glob, [[], [*] and [?] match those characters themselves)");
       }
     }
   }
@@ -183,9 +186,10 @@ bool glob_match(std::string_view pattern, std::string_view name) {
   return p == pattern.size();
 }
 
-/// Regular files (symlinks followed) directly in `dir`, by name, and links to nothing: a
+/// Regular files (symlinks followed) directly in `dir`, sorted by name, and links to nothing: a
 /// frame whose link is broken is listed, so that reading it is the error that names it
-/// instead of a frame left out in silence.
+/// instead of a frame left out in silence. Sorted, so that an error naming one of several
+/// files names the same one on every filesystem.
 std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequence) {
   std::vector<fs::path> files;
   std::error_code ec;
@@ -198,7 +202,54 @@ std::vector<fs::path> list_files(const fs::path& dir, const std::string& sequenc
     if (entry.is_regular_file(ignored) || dangling)
       files.push_back(dir.empty() ? entry.path().filename() : entry.path());
   }
+  std::sort(files.begin(), files.end());
   return files;
+}
+
+/// A directory's or a glob's files are numbered by the digits in their names: a file without
+/// any among others would be frame 0 and come first, so that a rest pose or a stray export left
+/// beside a cache would set the topology of the whole run. One file alone is frame 0.
+void require_numbered_names(const std::vector<Frame>& frames, const std::string& sequence) {
+  if (frames.size() < 2) return;
+  for (const Frame& f : frames) {
+    if (!last_digit_run(f.path.stem().string()).empty()) continue;
+    // Appended rather than chained: GCC 12 warns falsely (-Wrestrict) on '"'" + string + ...'.
+    std::string what = "'";
+    what += f.path.string();
+    what +=
+        "' has no digits in its name to number it as a frame; each file of a directory or a "
+        "glob is a frame numbered by the last digits in its name (move it away, or name the "
+        "frames with a pattern such as dress.%04d.obj or a glob that leaves it out)";
+    throw InputError(sequence, 0, what);
+  }
+}
+
+/// When a pattern matched nothing: names a file that it would match at another width (the
+/// pattern `drape.@.obj` against `drape.0001.obj`), and the token that matches it.
+std::string other_width_hint(const fs::path& dir, const FramePattern& pattern,
+                             const std::string& sequence) {
+  for (const fs::path& file : list_files(dir, sequence)) {
+    const std::string name = file.filename().string();
+    if (name.size() <= pattern.prefix.size() + pattern.suffix.size() ||
+        name.compare(0, pattern.prefix.size(), pattern.prefix) != 0 ||
+        name.compare(name.size() - pattern.suffix.size(), pattern.suffix.size(),
+                     pattern.suffix) != 0)
+      continue;
+    const std::string_view digits = std::string_view(name).substr(
+        pattern.prefix.size(), name.size() - pattern.prefix.size() - pattern.suffix.size());
+    if (!std::all_of(digits.begin(), digits.end(), is_digit)) continue;
+    std::string hint = "; '";
+    hint += name;
+    if (digits.size() > 1 && digits[0] == '0') {
+      const std::string width = std::to_string(digits.size());
+      hint += "' has its frame number padded to " + width + " digits: write %0" + width + "d, " +
+              std::string(digits.size(), '#') + " or $F" + width;
+    } else {
+      hint += "' has its frame number unpadded: write %d, # or $F";
+    }
+    return hint;
+  }
+  return {};
 }
 
 std::vector<Frame> sorted_unique(std::vector<Frame> frames, const std::string& sequence) {
@@ -237,6 +288,7 @@ std::vector<Frame> resolve_sequence(const std::string& sequence) {
       if (is_frame_file_extension(file)) frames.push_back({frame_number_from_name(file), file});
     }
     if (frames.empty()) throw InputError(sequence, 0, "directory has no .obj or .ply files");
+    require_numbered_names(frames, sequence);
     return sorted_unique(std::move(frames), sequence);
   }
   if (fs::exists(status)) {
@@ -274,8 +326,10 @@ std::vector<Frame> resolve_sequence(const std::string& sequence) {
   if (frames.empty()) {
     throw InputError(sequence, 0,
                      std::string("no files match the ") + (pattern ? "pattern" : "glob") + " in '" +
-                         (dir.empty() ? std::string(".") : dir.string()) + "'");
+                         (dir.empty() ? std::string(".") : dir.string()) + "'" +
+                         (pattern ? other_width_hint(dir, *pattern, sequence) : std::string()));
   }
+  if (!pattern) require_numbered_names(frames, sequence);
   return sorted_unique(std::move(frames), sequence);
 }
 
@@ -295,7 +349,9 @@ FrameSelection FrameSelection::parse(std::string_view text) {
     const size_t comma = text.find(',', pos);
     const std::string_view item =
         trim(text.substr(pos, comma == std::string_view::npos ? text.npos : comma - pos));
-    const std::string quoted = "'" + std::string(item) + "'";
+    std::string quoted = "'";  // appended: GCC 12 warns falsely (-Wrestrict) on the chain
+    quoted += item;
+    quoted += '\'';
     if (item.empty())
       throw UsageError("frame selection '" + std::string(text) + "' has an empty item" + expected);
     const char* p = item.data();
@@ -359,8 +415,8 @@ std::vector<std::string> FrameSelection::absent_runs(const std::vector<Frame>& f
   const auto add_run = [&](int64_t from, int64_t to, int64_t step) {
     if (from > to || runs.size() >= most_runs) return;
     std::string run = std::to_string(from);
-    if (to != from) run += "-" + std::to_string(to);
-    if (to != from && step != 1) run += "x" + std::to_string(step);
+    if (to != from) (run += '-') += std::to_string(to);
+    if (to != from && step != 1) (run += 'x') += std::to_string(step);
     if (std::find(runs.begin(), runs.end(), run) == runs.end()) runs.push_back(run);
   };
   for (const Range& r : ranges_) {
@@ -392,6 +448,25 @@ std::vector<std::string> FrameSelection::absent_runs(const std::vector<Frame>& f
     }
   }
   return runs;
+}
+
+FrameGaps frame_gaps(const std::vector<Frame>& frames, size_t most_runs) {
+  FrameGaps gaps;
+  if (frames.size() < 3) return gaps;
+  // The differences fit in 64 bits unsigned whatever the numbers (as in absent_runs).
+  uint64_t step = 0;
+  for (size_t i = 1; i < frames.size(); ++i)
+    step = std::gcd(step, static_cast<uint64_t>(frames[i].number) -
+                              static_cast<uint64_t>(frames[i - 1].number));
+  gaps.first = frames.front().number;
+  gaps.last = frames.back().number;
+  // Three distinct numbers spanning less than 2^64 have a divisor of their differences below
+  // 2^63: the step is an int64.
+  gaps.step = static_cast<int64_t>(step);
+  const FrameSelection grid = FrameSelection::parse(
+      std::to_string(gaps.first) + "-" + std::to_string(gaps.last) + "x" + std::to_string(step));
+  gaps.runs = grid.absent_runs(frames, most_runs);
+  return gaps;
 }
 
 std::vector<Frame> select_frames(const std::vector<Frame>& frames,

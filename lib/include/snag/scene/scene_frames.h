@@ -33,6 +33,9 @@ struct ResolvedScene {
   /// frame missing, which the user is told of.
   std::vector<std::string> absent_frames;
   static constexpr size_t kMostAbsentRuns = 6;
+  /// Without --frames: the numbers the first cloth's sequence skips (seq::frame_gaps, at most
+  /// kMostAbsentRuns runs), a frame a cache lost, which the user is told of.
+  seq::FrameGaps gaps;
   /// The object pairs checked (a <= b; a == b: self), in increasing order.
   std::vector<detect::PartCheck> checks;
 };

@@ -28,9 +28,10 @@ struct Frame {
 /// - a glob whose file name has `*`, `?` or `[...]` (`[!...]` negates): matching files, each
 ///   numbered by the last run of digits in its stem.
 /// Tokens and glob characters are understood in the last path component only.
-/// Throws snag::InputError naming SEQUENCE when nothing exists or matches, or when two files
-/// have the same frame number; snag::UsageError for an empty argument or a pattern with more
-/// than one frame token.
+/// Throws snag::InputError naming SEQUENCE when nothing exists or matches (for a pattern, naming
+/// a file it would match at another width), when two files have the same frame number, or when
+/// a directory or a glob gives several files and one has no digits in its name;
+/// snag::UsageError for an empty argument or a pattern with more than one frame token.
 std::vector<Frame> resolve_sequence(const std::string& sequence);
 
 /// The last run of decimal digits in the file's stem, 0 when there is none
@@ -65,6 +66,20 @@ class FrameSelection {
   std::string text_;
   bool all_ = true;
 };
+
+/// The numbers a sequence lacks between its first frame and its last (FrameGaps::runs), on the
+/// grid of the greatest common divisor of the differences between its numbers: a cache written
+/// every 5th frame (1, 6, 11, ...) has no gaps, and one of frames 1, 2, 3, 5 lacks 4.
+struct FrameGaps {
+  int64_t first = 0, last = 0;  ///< the first and last frame numbers
+  int64_t step = 0;             ///< the grid's step (0 when there are no runs to find)
+  /// The missing numbers as runs ("4", "6-7", "10-30x5"), at most `most_runs` of them.
+  std::vector<std::string> runs;
+};
+
+/// The gaps of `frames` (in increasing number, each number once, as resolve_sequence returns
+/// them). A sequence of fewer than three frames has none: two numbers make their own grid.
+FrameGaps frame_gaps(const std::vector<Frame>& frames, size_t most_runs);
 
 /// The frames of `frames` that `selection` contains, in the same order. Throws
 /// snag::UsageError when the selection keeps none of a non-empty sequence.
