@@ -153,11 +153,11 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
                    "its scalable-ccd/cloth-ball frames are a case", "time");
   cpu->add_option("--frames", o.frames, "Timed frames per case, after the warm-up")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   cpu->add_option("--warmup", o.warmup, "Untimed frames per case before the timed ones")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   cpu->add_option("--walk-lanes", o.walk_lanes,
                   "Leaves that walk the tree together: 4, 8 (needs AVX2 to be fast), or 0 for "

@@ -292,11 +292,11 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
                    "its files are inputs", "score");
   cmd->add_option("--frames", o.frames, "Frames per generated cloth")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   cmd->add_option("--warmup", o.warmup, "Untimed runs of each frame before the timed one")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   cmd->add_option("--hard", o.hard_dir,
                   "The hard-case corpus (default: samples/hard of $SNAG_SOURCE_DIR, else of the source tree "
@@ -304,7 +304,7 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
       ->type_name("DIR");
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   cmd->add_option("-o,--out", o.out_dir, "Write accuracy.csv and accuracy.md into DIR")
       ->type_name("DIR");

@@ -40,23 +40,23 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
   gpu->add_option("--large", o.large,
                   "Triangles of the large generated cloth, taken from its first frames (0: none)")
       ->type_name("T")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   gpu->add_option("--frames", o.frames, "Timed frames per case on the GPU, after the warm-up")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   gpu->add_option("--warmup", o.warmup, "Untimed frames per case before the timed ones")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   gpu->add_option("--cpu-frames", o.cpu_frames, "Timed frames per case on the CPU")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   gpu->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   return gpu;
 }

@@ -551,29 +551,29 @@ CLI::App* add_bench_io_command(CLI::App& bench, BenchIoOptions& o) {
       "reading it alone, and peak memory against sequence length");
   io->add_option("--size", o.size, "Triangles of the generated cloth")
       ->type_name("T")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   io->add_option("--frames", o.frames,
                  "Frames in the sequence (copies of the simulated frames, cyclically)")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   io->add_option("--passes", o.passes, "Timed passes over the frames per reader")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   io->add_option("--memory-frames", o.memory_frames,
                  "Sequence lengths whose peak memory is measured (0: none)")
       ->type_name("N,...")
       ->delimiter(',')
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   add_case_options(io, {nullptr, &o.data_dir, &o.inputs, &o.generator, &o.threads},
                    "its cloth-ball frames (big-endian PLY) are a reader case",
                    "read (and, from two frames on, check whole next to reading it)");
   io->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   return io;
 }

@@ -483,19 +483,19 @@ CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& o) {
       "obstacle, and a frozen frame, on the CPU and the GPU");
   cmd->add_option("--size", o.size, "Triangles of the generated cloth")
       ->type_name("T")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   cmd->add_option("--obstacle-size", o.obstacle_size, "Triangles of the sphere obstacle (about)")
       ->type_name("T")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   cmd->add_option("--frames", o.frames, "Timed frames per scene, after the first and the warm-up")
       ->type_name("N")
-      ->check(kPositive)
+      ->check(kPositiveCount)
       ->capture_default_str();
   cmd->add_option("--warmup", o.warmup, "Untimed frames per scene after the first")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   cmd->add_option("--backend", o.backend,
                   "cpu, cuda, or both (the CPU, and the GPU where snag has the CUDA backend and "
@@ -509,11 +509,11 @@ CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& o) {
       ->type_name("PATH");
   cmd->add_option("-j,--threads", o.threads, "CPU worker threads; 0 uses every core")
       ->type_name("N")
-      ->check(kThreadRange)
+      ->check(kThreadCount)
       ->capture_default_str();
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   return cmd;
 }

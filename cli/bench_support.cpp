@@ -162,7 +162,7 @@ void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& da
                     "Generated cloth sizes in triangles (0 or an empty list: none)")
         ->type_name("T,...")
         ->delimiter(',')
-        ->check(kNonNegative)
+        ->check(kCount)
         ->capture_default_str();
   cmd->add_option("--data", *o.data_dir,
                   "The shared data folder; " + data_cases +
@@ -179,7 +179,7 @@ void add_case_options(CLI::App* cmd, const CaseOptions& o, const std::string& da
       ->type_name("PATH");
   cmd->add_option("-j,--threads", *o.threads, "CPU worker threads; 0 uses every core")
       ->type_name("N")
-      ->check(kThreadRange)
+      ->check(kThreadCount)
       ->capture_default_str();
 }
 

@@ -47,19 +47,6 @@ CLI::Validator non_empty(const std::string& what) {
       "", "non-empty");
 }
 
-/// A directory option's value that is not an option: `--out -q` took -q as the directory and
-/// wrote the reports into ./-q (a directory of that name is still ./-q).
-CLI::Validator not_an_option(const std::string& what) {
-  return CLI::Validator(
-      [what](std::string& value) -> std::string {
-        if (value.size() > 1 && value[0] == '-')
-          return "expected " + what + ", found the option " + value + " (a directory of that " +
-                 "name is ./" + value + ")";
-        return "";
-      },
-      "", "not an option");
-}
-
 detect::RebuildPolicy rebuild_policy(const std::string& name) {
   if (name == "never") return detect::RebuildPolicy::never;
   if (name == "always") return detect::RebuildPolicy::always;
@@ -267,12 +254,14 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
                   "A body or prop SEQUENCE checked against the cloth (one file: still); "
                   "repeatable. Its own self-intersections are not checked")
       ->type_name("SEQUENCE")
+      ->check(not_an_option("a sequence"))
       ->expected(1)  // one value a flag, repeated: `--obstacle body.obj dress.%04d.obj` works
       ->take_all()
       ->allow_extra_args(false);
   cmd->add_option("--scene", o.scene,
                   "A scene file (JSON): objects, their roles, checks, weld and ignore rules")
-      ->type_name("FILE");
+      ->type_name("FILE")
+      ->check(not_an_option("a scene file"));
   cmd->add_flag("--split-groups", o.split_groups,
                 "Each OBJ o/g group of SEQUENCE is an object of its own, checked against itself "
                 "and every other group");
@@ -280,6 +269,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
                   "With --split-groups: this group is an obstacle (not checked against itself "
                   "or other obstacles); repeatable")
       ->type_name("NAME")
+      ->check(not_an_option("a group name"))
       ->expected(1)
       ->take_all()
       ->allow_extra_args(false);
@@ -292,7 +282,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("SEL")
       ->check(non_empty("a frame selection"));
   cmd->add_option("--weld", o.weld,
-                  "Vertices closer than TOL count as one for adjacency (reports keep the "
+                  "Vertices at most TOL apart count as one for adjacency (reports keep the "
                   "file's ids)")
       ->type_name("TOL")
       ->check(kNonNegative);
@@ -306,7 +296,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
                   "With --rebuild auto: rebuild when the refit tree's quality exceeds this "
                   "factor times its quality after the last build")
       ->type_name("FACTOR")
-      ->check(CLI::Range(1.0, 1e9))
+      ->check(number_above(1, false, "FLOAT >= 1"))
       ->capture_default_str();
   cmd->add_option(
          "--backend", o.backend,
@@ -318,12 +308,12 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->capture_default_str();
   cmd->add_option("--device", o.device, "CUDA device for the cuda backend, numbered from 0")
       ->type_name("N")
-      ->check(kNonNegative)
+      ->check(kCount)
       ->capture_default_str();
   cmd->add_option("-j,--threads", o.threads,
                   "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core")
       ->type_name("N")
-      ->check(kThreadRange)
+      ->check(kThreadCount)
       ->capture_default_str();
   cmd->add_option("--fail-on", o.fail_on,
                   "Exit with status 1 when a frame has: crossing pairs, any pair, or none (never)")

@@ -5,6 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <charconv>
+#include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,8 +17,6 @@ namespace snag::cli {
 /// The most threads --threads takes: far past any machine's cores, short of the thread counts
 /// that exhaust a process's stacks (-j 100000 crashed the run).
 inline constexpr int kMostThreads = 4096;
-/// --threads N: 0 (every core) to kMostThreads.
-inline const CLI::Range kThreadRange(0, kMostThreads);
 
 /// A number above `least` (`strictly`) or at least it, NaN refused: CLI11's PositiveNumber and
 /// NonNegativeNumber, whose messages print the largest double in full ("not in range 0.000000
@@ -31,8 +32,43 @@ inline CLI::Validator number_above(double least, bool strictly, const std::strin
       },
       description);
 }
-inline const CLI::Validator kPositive = number_above(0, true, "POSITIVE");
 inline const CLI::Validator kNonNegative = number_above(0, false, "NONNEGATIVE");
+
+/// A whole number from `least` to `most`: CLI11's Range answers a word with "Value abc not in
+/// range 0 to 4096", and an int option given 1.5 fails with "Could not convert".
+inline CLI::Validator whole_number(int64_t least, int64_t most, const std::string& description) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        int64_t value = 0;
+        const char* end = text.data() + text.size();
+        const auto [stop, error] = std::from_chars(text.data(), end, value);
+        if (error == std::errc() && stop == end && value >= least && value <= most) return {};
+        std::string range = most == std::numeric_limits<int>::max()
+                                ? ">= " + std::to_string(least)
+                                : "from " + std::to_string(least) + " to " + std::to_string(most);
+        return "expected a whole number " + range + ", got '" + text + "'";
+      },
+      description);
+}
+/// --threads N: 0 (every core) to kMostThreads.
+inline const CLI::Validator kThreadCount = whole_number(0, kMostThreads, "INT in [0 - 4096]");
+inline const CLI::Validator kPositiveCount =
+    whole_number(1, std::numeric_limits<int>::max(), "POSITIVE");
+inline const CLI::Validator kCount =
+    whole_number(0, std::numeric_limits<int>::max(), "NONNEGATIVE");
+
+/// An option's value that is not an option: `--out -q` took -q as the directory and wrote the
+/// reports into ./-q, `--obstacle -q` read the file -q. `what` is what was expected.
+inline CLI::Validator not_an_option(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& value) -> std::string {
+        if (value.size() > 1 && value[0] == '-')
+          return "expected " + what + ", found the option " + value + " (write ./" + value +
+                 " for one of that name)";
+        return "";
+      },
+      "", "not an option");
+}
 
 /// Options of `snag check`, filled by CLI11.
 struct CheckOptions {

@@ -8,8 +8,13 @@
 #include <signal.h>
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
+#include <cstring>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "backend_factory.h"
 #include "commands.h"
@@ -38,6 +43,43 @@ void remove_temporaries_when_killed() {
   }
 }
 
+/// An option given twice takes its last value, as wrapper scripts that append their overrides
+/// expect (`snag check $STUDIO_DEFAULTS --threads 4`); CLI11 would refuse the run ("At Most 1
+/// required but received 2"). Repeatable options keep every value.
+void take_the_last_of_repeated_options(CLI::App& app) {
+  for (CLI::Option* option : app.get_options())
+    if (option->nonpositional() && option->get_items_expected_max() == 1 &&
+        option->get_multi_option_policy() == CLI::MultiOptionPolicy::Throw)
+      option->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+    take_the_last_of_repeated_options(*command);
+}
+
+/// CLI11's message for a command line whose command or benchmark is missing or misspelt ("A
+/// subcommand is required", also for `snag --bogus`): what was expected, and what was found.
+/// `app` is the top-level app, whatever level failed: the one that failed is the deepest
+/// command parsed.
+std::string failure_text(const CLI::App* app, const CLI::Error& error) {
+  if (dynamic_cast<const CLI::RequiredError*>(&error) == nullptr ||
+      std::string_view(error.what()) != "A subcommand is required")
+    return CLI::FailureMessage::simple(app, error);
+  const CLI::App* failed = app;
+  while (!failed->get_subcommands().empty()) failed = failed->get_subcommands().front();
+  const std::vector<const CLI::App*> commands = failed->get_subcommands({});
+  std::string expected;
+  for (size_t i = 0; i < commands.size(); ++i) {
+    expected += i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ";
+    expected += commands[i]->get_name();
+  }
+  const std::vector<std::string> left = failed->remaining();
+  std::string found = "nothing";
+  if (!left.empty())
+    found = left.front().starts_with("-") ? "the option " + left.front() : "'" + left.front() + "'";
+  const std::string prefix = failed == app ? "" : failed->get_name() + ": ";
+  return prefix + "expected a command, " + expected + ", found " + found +
+         "\nRun with --help for more information.\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,7 +100,7 @@ int main(int argc, char** argv) {
     // CLI11's own messages (a bad value, an unknown option) start as snag's do; set before the
     // subcommands are added, which copy it.
     app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
-      return "snag: error: " + CLI::FailureMessage::simple(failed, e);
+      return "snag: error: " + failure_text(failed, e);
     });
     app.require_subcommand(1, 1);
     snag::cli::CheckOptions check;
@@ -82,6 +124,8 @@ int main(int argc, char** argv) {
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
         "3 input or output error, 4 internal error. See snag(1).");
 
+    take_the_last_of_repeated_options(app);
+
     // A first word that names no command: CLI11 would answer "A subcommand is required" (and
     // `snag report --help` would print the top-level help and exit 0).
     const auto names_a_command = [&](const std::string& word) {
@@ -93,16 +137,31 @@ int main(int argc, char** argv) {
       throw snag::UsageError("unknown command '" + std::string(argv[1]) +
                              "'; expected check or bench");
     app.parse(argc, argv);
-    if (check_command->parsed()) return snag::cli::run_check(check);
-    if (bench_cpu_command->parsed()) return snag::cli::run_bench_cpu(bench);
-    if (bench_gpu_command->parsed()) return snag::cli::run_bench_gpu(bench_gpu);
-    if (bench_accuracy_command->parsed()) return snag::cli::run_bench_accuracy(bench_accuracy);
-    if (bench_io_command->parsed()) return snag::cli::run_bench_io(bench_io);
-    if (bench_scene_command->parsed()) return snag::cli::run_bench_scene(bench_scene);
-    throw snag::InternalError("no subcommand ran");
+    int status = -1;
+    if (check_command->parsed()) status = snag::cli::run_check(check);
+    if (bench_cpu_command->parsed()) status = snag::cli::run_bench_cpu(bench);
+    if (bench_gpu_command->parsed()) status = snag::cli::run_bench_gpu(bench_gpu);
+    if (bench_accuracy_command->parsed()) status = snag::cli::run_bench_accuracy(bench_accuracy);
+    if (bench_io_command->parsed()) status = snag::cli::run_bench_io(bench_io);
+    if (bench_scene_command->parsed()) status = snag::cli::run_bench_scene(bench_scene);
+    if (status < 0) throw snag::InternalError("no subcommand ran");
+    // A summary that never reached its reader (a full disk, a closed file) is no success: a
+    // gate reading it would see nothing, or half of it.
+    std::cout.flush();
+    if (!std::cout) {
+      const int err = errno;
+      std::cerr << "snag: cannot write to standard output"
+                << (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) << "\n";
+      return 3;
+    }
+    return status;
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.
     const int code = app.exit(e);
+    if (code == 0 && !std::cout.flush()) {
+      std::cerr << "snag: cannot write to standard output\n";
+      return 3;
+    }
     return code == 0 ? 0 : 2;
   } catch (const snag::UsageError& e) {
     std::cerr << "snag: error: " << e.what() << "\nRun with --help for more information.\n";

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -403,6 +404,57 @@ TEST(CliStatus, UsageErrorsExitTwo) {
   }
 }
 
+// Each usage error says what was expected and what was found, in words (not CLI11's "A
+// subcommand is required", "Value abc not in range 0 to 4096" or "Could not convert").
+TEST(CliStatus, UsageErrorsSayWhatWasExpected) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{}, "snag: error: expected a command, check or bench, found nothing\n"},
+      {{"--bogus"}, "expected a command, check or bench, found the option --bogus\n"},
+      {{"bench"}, "bench: expected a command, cpu, gpu, accuracy, io or scene, found nothing"},
+      {{"bench", "foo"}, "bench: expected a command, cpu, gpu, accuracy, io or scene, found 'foo'"},
+      {{"check", "seq", "--threads", "abc"},
+       "--threads: expected a whole number from 0 to 4096, got 'abc'"},
+      {{"check", "seq", "--threads", "1.5"},
+       "--threads: expected a whole number from 0 to 4096, got '1.5'"},
+      {{"check", "seq", "--device", "1.5"}, "--device: expected a whole number >= 0, got '1.5'"},
+      {{"check", "seq", "--rebuild-threshold", "abc"},
+       "--rebuild-threshold: expected a number, got 'abc'"},
+      {{"check", "seq", "--rebuild-threshold", "0.5"},
+       "--rebuild-threshold: expected a number >= 1, got '0.5'"},
+      {{"check", "seq", "--obstacle", "-q"},
+       "--obstacle: expected a sequence, found the option -q (write ./-q for one of that name)"},
+      {{"check", "--scene", "-q"}, "--scene: expected a scene file, found the option -q"},
+      {{"bench", "cpu", "--frames", "2.5"}, "--frames: expected a whole number >= 1, got '2.5'"},
+      {{"bench", "cpu", "--sizes", "2244,x"}, "--sizes: expected a whole number >= 0, got 'x'"},
+  };
+  for (const auto& [args, expected] : cases) {
+    std::string line;
+    for (const auto& a : args) line += " " + a;
+    const RunResult r = run_snag(args, tmp.path());
+    EXPECT_EQ(r.status, 2) << "snag" << line << "\n" << context(r);
+    EXPECT_NE(r.err.find(expected), std::string::npos) << "snag" << line << ": " << r.err;
+    EXPECT_NE(r.err.find("Run with --help for more information."), std::string::npos) << r.err;
+  }
+}
+
+// An option given twice takes its last value (a wrapper script appending its overrides);
+// repeatable options keep each value.
+TEST(CliStatus, RepeatedOptionsTakeTheirLastValue) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");  // crossings: status 1 under --fail-on crossing
+  const RunResult none_last =
+      run_snag({"check", "seq", "--fail-on", "crossing", "--fail-on", "none", "-q"}, tmp.path());
+  EXPECT_EQ(none_last.status, 0) << context(none_last);
+  const RunResult crossing_last = run_snag(
+      {"check", "seq", "--fail-on", "none", "--fail-on", "crossing", "--out", "a", "--out", "b"},
+      tmp.path());
+  EXPECT_EQ(crossing_last.status, 1) << context(crossing_last);
+  EXPECT_FALSE(fs::exists(tmp.path() / "a"));
+  EXPECT_TRUE(fs::exists(tmp.path() / "b" / "pairs.csv"));
+}
+
 TEST(CliStatus, CudaBackendRunsOrExitsFourWithAReason) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");
@@ -493,6 +545,29 @@ TEST(CliStatus, MissingSequenceAndUnwritableOutExitThree) {
   EXPECT_EQ(r.status, 3) << context(r);
   EXPECT_NE(r.err.find("not a directory"), std::string::npos) << r.err;
   EXPECT_EQ(read_text(tmp.path() / "a-file"), "x");
+}
+
+// A summary that cannot be written (standard output on a full disk) fails the run, after the
+// reports it could write; so does help that cannot be.
+TEST(CliStatus, AnUnwritableStandardOutputExitsThree) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const auto run_into_full = [&](const std::string& args) {
+    const std::string command = "cd '" + tmp.path().string() + "' && '" +
+                                snag_executable().string() + "' " + args + " >/dev/full 2>err.txt";
+    const int status = std::system(command.c_str());
+    EXPECT_TRUE(WIFEXITED(status)) << command;
+    return WEXITSTATUS(status);
+  };
+  EXPECT_EQ(run_into_full("check seq --fail-on none --out out"), 3);
+  EXPECT_NE(read_text(tmp.path() / "err.txt").find("snag: cannot write to standard output"),
+            std::string::npos)
+      << read_text(tmp.path() / "err.txt");
+  EXPECT_TRUE(fs::exists(tmp.path() / "out" / "report.json"));
+  EXPECT_EQ(run_into_full("check --help"), 3);
+  // To a writable place, the same runs succeed.
+  EXPECT_EQ(run_snag({"check", "seq", "--fail-on", "none", "-q"}, tmp.path()).status, 0);
 }
 
 /// Long and short options named in `text`: "--word" and " -x".
