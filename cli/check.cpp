@@ -101,6 +101,33 @@ std::vector<report::ObjectInput> object_inputs(const scene::ResolvedScene& scene
 /// vertices zeroed, or a simulation collapsed to a point. Its faces pair with nothing, so the
 /// frame checks clean and a gate would pass it in silence. The objects of the first kNamed such
 /// frames are named in a warning as they are checked, the other frames counted in one at the end.
+/// The --out directory, made ready (report::prepare_output_dir), and those of it and its
+/// parents that this run created: removed again while empty when the run fails, so that a
+/// failed run leaves nothing behind where there was nothing.
+class OutputDirectory {
+ public:
+  explicit OutputDirectory(const std::filesystem::path& dir) {
+    std::error_code ec;
+    std::filesystem::path path = std::filesystem::absolute(dir, ec).lexically_normal();
+    if (!ec && path.filename().empty()) path = path.parent_path();  // "out/"
+    for (; !ec && path.has_relative_path() && !std::filesystem::exists(path, ec);
+         path = path.parent_path())
+      created_.push_back(path);  // deepest first
+    report::prepare_output_dir(dir);
+  }
+  ~OutputDirectory() {
+    std::error_code ignored;  // a directory no longer empty (another run's reports) stays
+    for (const std::filesystem::path& path : created_) std::filesystem::remove(path, ignored);
+  }
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+  /// The run succeeded: the directory holds its reports.
+  void keep() { created_.clear(); }
+
+ private:
+  std::vector<std::filesystem::path> created_;
+};
+
 class CollapsedFrames {
  public:
   static constexpr int64_t kNamed = 3;
@@ -374,7 +401,8 @@ int run_check(const CheckOptions& o) {
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
   // once rather than after an hour of checking.
-  if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
+  std::optional<OutputDirectory> output_directory;
+  if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
 
   // The run's threads are the checker's and its readers' (checker_threads_for).
   const int threads = thread_count(o.threads);
@@ -438,6 +466,7 @@ int run_check(const CheckOptions& o) {
   // Only now, with every frame read, checked and written, do the report files appear.
   const report::Summary summary =
       reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
+  if (output_directory) output_directory->keep();
 
   print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs);
   std::cout.flush();

@@ -497,8 +497,15 @@ TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {
   const RunResult r = run_snag({"check", "seq", "--out", "out"}, tmp.path());
   EXPECT_EQ(r.status, 3) << context(r);
   EXPECT_NE(r.err.find("f.0004.obj:3"), std::string::npos) << r.err;
-  if (fs::exists(tmp.path() / "out"))
-    EXPECT_EQ(directory_entries(tmp.path() / "out"), std::vector<std::string>{});
+  // The directories the run made for its reports go with them; one that was there stays.
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+  const RunResult nested = run_snag({"check", "seq", "--out", "new/reports/"}, tmp.path());
+  EXPECT_EQ(nested.status, 3) << context(nested);
+  EXPECT_FALSE(fs::exists(tmp.path() / "new"));
+  fs::create_directory(tmp.path() / "there");
+  EXPECT_EQ(run_snag({"check", "seq", "--out", "there/reports"}, tmp.path()).status, 3);
+  EXPECT_EQ(directory_entries(tmp.path() / "there"), std::vector<std::string>{});
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "there"));
 }
 
 TEST(CliStatus, BadFrameInTheMiddleKeepsTheEarlierReports) {

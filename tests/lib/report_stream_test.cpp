@@ -545,6 +545,42 @@ TEST(ReportStream, ExceptionMidRunLeavesNoFileAndKeepsTheEarlierRun) {
   expect_earlier_run(tmp.path());
 }
 
+// A directory holding a report's name: no rename can replace it. Found when the stream starts
+// (not after the run), and again before the first rename, so that the reports are never half
+// replaced (pairs.csv new, report.json old).
+TEST(ReportStream, ADirectoryInAReportsPlaceFailsBeforeAnyReportIsReplaced) {
+  TempDir tmp;
+  write_earlier_run(tmp.path());
+  fs::remove(tmp.path() / "report.json");
+  fs::create_directory(tmp.path() / "report.json");
+  try {
+    ReportStream stream(tmp.path(), "1.2.3", small_settings());
+    ADD_FAILURE() << "the stream started";
+  } catch (const WriteError& e) {
+    EXPECT_EQ(e.path(), tmp.path() / "report.json");
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  fs::remove(tmp.path() / "report.json");
+  std::ofstream(tmp.path() / "report.json") << "old report";
+  expect_earlier_run(tmp.path());
+
+  // Made during the run: finish() fails and replaces nothing.
+  const auto run_whose_last_report_is_taken = [&](const std::string& taken) {
+    ReportStream stream(tmp.path(), "1.2.3", small_settings());
+    for (const FrameRecord& f : small_frames()) stream.add(f);
+    fs::remove(tmp.path() / taken);
+    fs::create_directory(tmp.path() / taken);
+    stream.finish(small_inputs(), 1, 0, 0.5);
+  };
+  for (const std::string& taken : {"frames.csv", "report.json"}) {
+    SCOPED_TRACE(taken);
+    EXPECT_THROW(run_whose_last_report_is_taken(taken), WriteError);
+    fs::remove(tmp.path() / taken);
+    std::ofstream(tmp.path() / taken) << (taken == "frames.csv" ? "old frames" : "old report");
+    expect_earlier_run(tmp.path());
+  }
+}
+
 // What a SIGINT or SIGTERM handler calls (cli/main.cpp), in a child process as in a handler
 // (it leaves the process removing every temporary made after it): the temporaries of a stream
 // still writing go, an earlier run's reports and a finished stream's stay.

@@ -66,6 +66,15 @@ void untrack(int slot) {
   if (slot >= 0) tracked[slot].state.store(kFree);
 }
 
+/// A final name that a directory holds: rename cannot replace it, and a commit that found out
+/// at its second or third rename would leave the reports half replaced. (A link is replaced
+/// itself, whatever it points to.)
+void require_replaceable(const fs::path& final_path) {
+  std::error_code ec;
+  if (fs::is_directory(fs::symlink_status(final_path, ec)))
+    throw WriteError(final_path, "is a directory, which the report cannot replace");
+}
+
 }  // namespace
 
 void remove_temporaries_on_signal() noexcept {
@@ -163,6 +172,7 @@ StagedFile& StagedFiles::open(fs::path temporary_path, const std::string& name, 
 }
 
 StagedFile& StagedFiles::create(const std::string& name) {
+  require_replaceable(dir_ / name);  // at once, rather than after an hour of checking
   return open(temporary_name(dir_, name), name, false);
 }
 
@@ -179,6 +189,10 @@ void StagedFiles::commit() {
       remove_quietly(e.temporary_path);
       untrack(std::exchange(e.tracked_slot, -1));
     }
+  // Every final name checked again before the first rename (a directory made there since
+  // create()): what can still fail between two renames is the directory itself going.
+  for (const Entry& e : entries_)
+    if (!e.scratch) require_replaceable(e.file->final_path());
   for (Entry& e : entries_) {
     if (e.scratch) continue;
     std::error_code ec;

@@ -81,17 +81,19 @@ class StagedFiles {
   StagedFiles& operator=(const StagedFiles&) = delete;
 
   /// A temporary that commit() renames to `dir / name`. The reference stays valid for the
-  /// set's lifetime. Throws WriteError naming `dir / name` when it cannot be created.
+  /// set's lifetime. Throws WriteError naming `dir / name` when it cannot be created, or when a
+  /// directory holds that name (which no rename could replace).
   StagedFile& create(const std::string& name);
   /// A temporary that holds a piece `part` of the file `name` while it is being composed
   /// (errors name `dir / name`); removed by commit() and never renamed.
   StagedFile& create_scratch(const std::string& name, const std::string& part);
 
   /// Closes every file (WriteError when a write failed, then nothing is renamed), removes the
-  /// scratch files and renames the others into place. The renames are the only step that
-  /// replaces an earlier run's files; each is atomic, and only an error between two of them
-  /// (the directory removed or made read-only meanwhile) could leave some renamed and others
-  /// not. Commit at most once.
+  /// scratch files and renames the others into place, after checking that no directory has
+  /// taken a final name since create() (WriteError, nothing renamed). The renames are the only
+  /// step that replaces an earlier run's files; each is atomic, and only an error between two
+  /// of them (the directory removed or made read-only meanwhile) could leave some renamed and
+  /// others not. Commit at most once.
   void commit();
 
  private:
