@@ -7,6 +7,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -182,14 +183,23 @@ Input hard_corpus(const fs::path& dir) {
   if (list) {
     std::string line;
     std::getline(list, line);  // header
-    while (std::getline(list, line)) {
+    for (int64_t line_number = 2; std::getline(list, line); ++line_number) {
       std::stringstream fields(line);
       std::string name, file, weld;
       std::getline(fields, name, ',');
       std::getline(fields, file, ',');
       std::getline(fields, weld, ',');
       if (file.empty()) continue;
-      files.emplace_back(dir / file, weld.empty() ? std::nullopt : std::optional(std::stod(weld)));
+      std::optional<double> tolerance;
+      if (!weld.empty()) {
+        double value = 0;
+        const auto [end, error] = std::from_chars(weld.data(), weld.data() + weld.size(), value);
+        if (error != std::errc() || end != weld.data() + weld.size() || !(value >= 0))
+          throw InputError((dir / "cases.csv").string(), line_number,
+                           "weld '" + weld + "' is not a number >= 0");
+        tolerance = value;
+      }
+      files.emplace_back(dir / file, tolerance);
     }
   } else {
     for (const auto& entry : fs::directory_iterator(dir))
@@ -202,6 +212,8 @@ Input hard_corpus(const fs::path& dir) {
       m.triangles = mesh::welded_triangles(m.triangles, mesh::weld_representatives(m.positions, *weld));
     input.frames.push_back(std::move(m));
   }
+  if (input.frames.empty())
+    throw UsageError("--hard " + dir.string() + ": no cases in it (a cases.csv, or .obj files)");
   input.cases = static_cast<int>(input.frames.size());
   input.name += " (" + std::to_string(input.cases) + " cases)";
   return input;
@@ -337,6 +349,8 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
               generated_cloth(o.generator, size, settle_frames, o.frames, dir)});
   }
   const fs::path data = data_folder(o.data_dir);
+  // Each case of the data folder that is there (a partial copy of it is still a corpus); a
+  // --data folder that holds none of them is a usage error, as a mistyped path.
   std::vector<BenchCase> data_cases;
   for (const auto& [name, folder] :
        std::vector<std::pair<std::string, std::string>>{
@@ -346,12 +360,18 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
            {"armadillo-rollers", "scalable-ccd/armadillo-rollers"},
            {"rod-twist", "scalable-ccd/rod-twist"},
            {"thick-cloth", "ipc-toolkit/thick-cloth"}})
-    add_data_case(data_cases, data, o.data_dir, name, folder, command);
-  for (const BenchCase& c : data_cases) add_case(c);
+    add_data_case(data_cases, data, "", name, folder, command);
   if (!data.empty() && fs::is_directory(data / "ipc-toolkit"))
     for (const char* file : {"two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"})
       if (fs::exists(data / "ipc-toolkit" / file))
-        add_case(sequence_case(std::string("ipc ") + file, (data / "ipc-toolkit" / file).string()));
+        data_cases.push_back(
+            sequence_case(std::string("ipc ") + file, (data / "ipc-toolkit" / file).string()));
+  if (!o.data_dir.empty() && data_cases.empty())
+    throw UsageError("--data " + o.data_dir +
+                     ": none of its cases is in it (scalable-ccd/cloth-ball, cloth-funnel, "
+                     "n-body-simulation, armadillo-rollers, rod-twist; ipc-toolkit/thick-cloth, "
+                     "two-cubes-*.ply)");
+  for (const BenchCase& c : data_cases) add_case(c);
   for (const std::string& sequence : o.inputs) add_case(sequence_case(sequence, sequence));
   if (inputs.empty()) throw UsageError("snag bench accuracy: no inputs");
 
@@ -378,14 +398,18 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
                 "snag bench accuracy: %d threads, %s; ms/frame is the median over the input's "
                 "frames; wrong counts are summed over them, against snag --exact all (CGAL-confirmed)",
                 threads, cuda_devices() > 0 ? "CPU and CUDA" : "CPU only (no CUDA device)");
-  std::printf("%s\n\n%-28s %9s %-28s %10s %8s %8s %8s %6s %9s\n", header, "input", "triangles",
-              "method", "ms/frame", "pairs", "false+", "false-", "kind", "unproven");
+  // The input column as wide as its longest name (a file given with --input can be long).
+  int input_width = 28;
   for (const Score& s : scores)
-    std::printf("%-28s %9lld %-28s %10.3f %8lld %8lld %8lld %6s %9lld\n", s.input.c_str(),
-                static_cast<long long>(s.triangles), s.method.c_str(), s.seconds * 1e3,
-                static_cast<long long>(s.pairs), static_cast<long long>(s.false_positive),
-                static_cast<long long>(s.false_negative), kinds_cell(s).c_str(),
-                static_cast<long long>(s.unproven));
+    input_width = std::max(input_width, static_cast<int>(s.input.size()));
+  std::printf("%s\n\n%-*s %9s %-28s %10s %8s %8s %8s %6s %9s\n", header, input_width, "input",
+              "triangles", "method", "ms/frame", "pairs", "false+", "false-", "kind", "unproven");
+  for (const Score& s : scores)
+    std::printf("%-*s %9lld %-28s %10.3f %8lld %8lld %8lld %6s %9lld\n", input_width,
+                s.input.c_str(), static_cast<long long>(s.triangles), s.method.c_str(),
+                s.seconds * 1e3, static_cast<long long>(s.pairs),
+                static_cast<long long>(s.false_positive), static_cast<long long>(s.false_negative),
+                kinds_cell(s).c_str(), static_cast<long long>(s.unproven));
   if (!o.out_dir.empty()) write_tables(scores, o.out_dir, header);
   return 0;
 }

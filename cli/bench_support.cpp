@@ -98,7 +98,11 @@ std::vector<fs::path> generated_cloth(const std::string& generator, int triangle
   if (!run.started)
     throw UsageError("cannot run the sample generator '" + program +
                      "' (build it, or give its path with --generator)");
-  if (run.exit_status != 0) throw InternalError("the sample generator '" + program + "' failed");
+  if (run.exit_status != 0)
+    throw InternalError("the sample generator '" + program + "' failed (" +
+                        (run.exit_status < 0 ? std::string("killed by a signal")
+                                             : "exit status " + std::to_string(run.exit_status)) +
+                        ")");
   std::vector<fs::path> files;
   for (const seq::Frame& f : seq::resolve_sequence(dir.string())) files.push_back(f.path);
   if (files.size() > static_cast<size_t>(keep)) files.erase(files.begin(), files.end() - keep);
