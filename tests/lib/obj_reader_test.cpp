@@ -367,14 +367,20 @@ TEST(ObjReader, RejectsAKeywordRunIntoItsNumbers) {
   expect_rejected("v 0 0 0\nv 1 0 0\nv 0 1 0\nf1 2 3\n", 4, "after 'f', found 'f1'");
 }
 
-// A lone CR anywhere in a line passed over (a file whose lines end with one reads as a single
-// comment line otherwise); CRLF is a line end.
+// A lone CR anywhere in a line passed over or naming a group (a file whose lines end with one reads
+// as a single comment line otherwise); CRLF is a line end.
 TEST(ObjReader, RejectsALoneCrInALinePassedOver) {
   const InputError e = reject("# exported\rv 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r");
   EXPECT_EQ(e.line(), 1) << e.what();
   EXPECT_NE(std::string(e.what()).find("lone CR"), std::string::npos) << e.what();
   expect_rejected("v 0 0 0\nvn 0 0 1\rvn 0 1 0\n", 2, "lone CR");
   EXPECT_EQ(read_obj("# c\r\nvn 0 0 1\r\nv 0 0 0\r", "t.obj").positions.size(), 1u);
+  // A group's name too (found by fuzzing: the name swallowed the file, which read as empty).
+  expect_rejected("o cloth\rv 0 0 0\rv 2 0 0\rv 0 2 0\rf 1 2 3\r", 1, "lone CR");
+  expect_rejected("v 0 0 0\nv 2 0 0\nv 0 2 0\ng a\rf 1 2 3\n", 4, "lone CR");
+  const mesh::Mesh crlf = read_obj("v 0 0 0\r\nv 2 0 0\r\nv 0 2 0\r\ng a\r\nf 1 2 3\r\n", "t.obj");
+  ASSERT_EQ(crlf.group_names, std::vector<std::string>{"a"});
+  EXPECT_EQ(crlf.triangles.size(), 1u);
 }
 
 TEST(ObjReader, RejectsNanAndInf) {

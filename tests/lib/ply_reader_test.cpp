@@ -553,6 +553,38 @@ TEST(PlyReader, AsciiIntegerCoordinatesAreValuesOfTheirType) {
                   "expected a whole number from 0 to 255");
 }
 
+// A list's count and its corners in an ascii file are values of their declared types too
+// (found by fuzzing: a uchar list held a 300-gon and corners past 255).
+TEST(PlyReader, AsciiListCountsAndCornersAreValuesOfTheirTypes) {
+  std::string vertices;
+  for (int v = 0; v < 300; ++v)
+    vertices += std::to_string(v) + " " + std::to_string(v % 7) + " 0\n";
+  const auto file = [&](const std::string& list, const std::string& face) {
+    return "ply\nformat ascii 1.0\nelement vertex 300\nproperty float x\nproperty float y\n"
+           "property float z\nelement face 1\nproperty " +
+           list + " vertex_indices\nend_header\n" + vertices + face + "\n";
+  };
+  std::string gon = "300";
+  for (int v = 0; v < 300; ++v) gon += " " + std::to_string(v);
+  expect_contains(reject(file("list uchar int", gon)),
+                  "list 'vertex_indices' of face 0 (of 1) has count 300, more than its uchar "
+                  "type holds (at most 255)");
+  EXPECT_EQ(read_ply(file("list ushort int", gon), "t.ply").triangles.size(), 298u);
+  expect_contains(reject(file("list uchar uchar", "3 0 1 299")),
+                  "has vertex index 299, more than its uchar type holds (at most 255)");
+  expect_contains(reject(file("list uchar char", "3 0 1 128")), "more than its char type");
+  EXPECT_EQ(read_ply(file("list uchar uchar", "3 0 1 255"), "t.ply").triangles.size(), 1u);
+  // A skipped list's count as well.
+  const std::string skipped =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list char int texcoord\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  std::string long_list = "128";
+  for (int k = 0; k < 128; ++k) long_list += " 0";
+  expect_contains(reject(skipped + long_list + " 3 0 1 2\n"),
+                  "'texcoord' of face 0 (of 1) has count 128, more than its char type");
+}
+
 TEST(PlyReader, RejectsNegativeListCounts) {
   for (Enc enc : {Enc::ascii, Enc::le, Enc::be}) {
     SCOPED_TRACE(format_name(enc));

@@ -140,11 +140,7 @@ class ObjParser {
         ((p_[1] >= '0' && p_[1] <= '9') || p_[1] == '-' || p_[1] == '+' || p_[1] == '.'))
       fail("expected a blank after '" + std::string(1, c) + "', found " + quote_token(p_, end_));
     const char* eol = detail::find_eol(p_, end_);
-    for (const char* cr = p_;
-         (cr = static_cast<const char*>(std::memchr(cr, '\r', static_cast<size_t>(eol - cr))));
-         ++cr)
-      if (cr + 1 < eol)
-        fail("a carriage return inside the line: are the file's lines ended by a lone CR?");
+    refuse_lone_cr(eol);
     p_ = eol;
     if (p_ < end_) {
       ++p_;
@@ -325,11 +321,23 @@ class ObjParser {
     ++mesh_.polygon_count;
   }
 
+  /// A carriage return in the line before its last byte (CRLF's CR is its last): the file's
+  /// lines end with a lone CR, and the rest of the file would be one long line to this reader
+  /// (a comment, or a group's name, that hides every record after it).
+  void refuse_lone_cr(const char* eol) {
+    for (const char* cr = p_;
+         (cr = static_cast<const char*>(std::memchr(cr, '\r', static_cast<size_t>(eol - cr))));
+         ++cr)
+      if (cr + 1 < eol)
+        fail("a carriage return inside the line: are the file's lines ended by a lone CR?");
+  }
+
   void parse_group() {
     ++p_;
     skip_blanks();
     const char* start = p_;
     const char* stop = detail::find_eol(p_, end_);
+    refuse_lone_cr(stop);
     while (stop > start && is_blank(stop[-1])) --stop;
     pending_name_ = std::string_view(start, static_cast<size_t>(stop - start));
     // An empty `g` returns to the default group; a name is interned only when a face uses it,

@@ -889,7 +889,24 @@ class AsciiBody {
       fail("list " + quote(prop.name) + " of " + record_name(el, i) + " has count " +
            std::to_string(n) + "; expected a count >= 0");
     }
+    check_fits(el, i, prop, prop.count_type, n, "count");
     return n;
+  }
+
+  /// A list's count or item read from the text must be a value of its declared type, as a
+  /// binary file's would be (`property list uchar int` holds at most 255 corners).
+  void check_fits(const Element& el, int64_t i, const Property& prop, Scalar type, int64_t value,
+                  const char* what) const {
+    if (static_cast<double>(value) > integer_range(type).second) [[unlikely]]
+      fail_fits(el, i, prop, type, value, what);
+  }
+  [[noreturn, gnu::cold, gnu::noinline]] void fail_fits(const Element& el, int64_t i,
+                                                        const Property& prop, Scalar type,
+                                                        int64_t value, const char* what) const {
+    fail("list " + quote(prop.name) + " of " + record_name(el, i) + " has " + what + " " +
+         std::to_string(value) + ", more than its " + std::string(scalar_type_name(type)) +
+         " type holds (at most " +
+         std::to_string(static_cast<int64_t>(integer_range(type).second)) + ")");
   }
 
   void read_vertex(const Element& el, int64_t i) {
@@ -971,6 +988,7 @@ class AsciiBody {
       if (n < 3) {
         fail(record_name(el, i) + " has " + counted(n, "corner") + "; expected at least 3");
       }
+      check_fits(el, i, prop, prop.count_type, n, "count");
       corners_.clear();
       for (int64_t c = 0; c < n; ++c) {
         const int64_t v = next_integer(el, i, prop, "vertex index",
@@ -980,6 +998,7 @@ class AsciiBody {
                std::to_string(v) + "; expected 0.." + std::to_string(vertex_count - 1) + " (" +
                std::to_string(vertex_count) + " vertices)");
         }
+        check_fits(el, i, prop, prop.type, v, "vertex index");
         corners_.push_back(static_cast<int32_t>(v));
       }
       add_polygon(mesh_, corners_, static_cast<int32_t>(i));
