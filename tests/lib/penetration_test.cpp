@@ -286,6 +286,34 @@ TEST(Penetration, IcosphereMatchesWindingNumberAndBruteForceDistance) {
   expect_surface_points_not_inside(meter, s, 13, "icosphere");
 }
 
+// The same scene at any magnitude gives the same points inside and depths scaled with it (found
+// by fuzzing: past 1e80 or under 1e-100 a face's squared normal overflowed or underflowed, and
+// no point was inside).
+TEST(Penetration, DepthsScaleWithTheCoordinatesAtEveryMagnitude) {
+  const Surface s = icosphere(3, 1.3, {0.1, -0.2, 0.3});
+  const std::vector<Vec3d> points = random_points(s, 2000, 31);
+  std::vector<double> base;
+  const PenetrationStats base_stats = meter_for(s).measure(points, 2, &base);
+  ASSERT_GT(base_stats.inside, 0);
+  for (double scale :
+       {0x1p-400, 0x1p-200, 1e-150, 0x1p-101, 1e-20, 1e20, 0x1p101, 1e130, 0x1p200, 0x1p400}) {
+    SCOPED_TRACE(scale);
+    Surface scaled_surface = s;
+    for (Vec3d& v : scaled_surface.positions) v = scale * v;
+    std::vector<Vec3d> scaled_points = points;
+    for (Vec3d& p : scaled_points) p = scale * p;
+    const PenetrationMeter meter = meter_for(scaled_surface);
+    EXPECT_GE(meter.enclosed_volume(), 0.0);  // 0 where scale^3 underflows
+    std::vector<double> depths;
+    const PenetrationStats stats = meter.measure(scaled_points, 2, &depths);
+    EXPECT_EQ(stats.inside, base_stats.inside);
+    for (size_t i = 0; i < points.size(); ++i) {
+      ASSERT_EQ(depths[i] > 0.0, base[i] > 0.0) << "point " << i;
+      ASSERT_NEAR(depths[i] / scale, base[i], 1e-12) << "point " << i;
+    }
+  }
+}
+
 TEST(Penetration, TorusMatchesWindingNumberAndBruteForceDistance) {
   const Surface s = torus(1.0, 0.35, 48, 24);
   ASSERT_GT(signed_volume(s), 0.0);

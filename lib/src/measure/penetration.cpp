@@ -160,9 +160,35 @@ std::optional<std::string> analyse(std::span<const geom::Tri> triangles, int32_t
 // ---------------------------------------------------------------------------------------------
 // Geometry of one query.
 
+/// v's direction, or zero for a zero (or not finite) v. A vector whose squared length would
+/// underflow or overflow (the normal of a feature 1e-100 across) is divided by its largest
+/// component first, so that it still has one.
 geom::Vec3d unit_or_zero(geom::Vec3d v) {
-  const double length = std::sqrt(geom::dot(v, v));
-  return length > 0.0 ? (1.0 / length) * v : geom::Vec3d{0.0, 0.0, 0.0};
+  const double length2 = geom::dot(v, v);
+  if (length2 >= std::numeric_limits<double>::min() &&
+      length2 < std::numeric_limits<double>::infinity())
+    return (1.0 / std::sqrt(length2)) * v;
+  const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  if (!(largest > 0.0 && largest < std::numeric_limits<double>::infinity()))
+    return geom::Vec3d{0.0, 0.0, 0.0};
+  const geom::Vec3d w{v.x / largest, v.y / largest, v.z / largest};
+  return (1.0 / std::sqrt(geom::dot(w, w))) * w;
+}
+
+/// p * 2^exponent, exactly (barring underflow to subnormals).
+geom::Vec3d scaled(geom::Vec3d p, int exponent) {
+  return {std::ldexp(p.x, exponent), std::ldexp(p.y, exponent), std::ldexp(p.z, exponent)};
+}
+
+/// The power of two that brings an obstacle's extent into [2^-100, 2^100], where the measure's
+/// squares, cross products and volumes cannot overflow or underflow: 0 (no scaling) for every
+/// extent already there, so that ordinary scenes are measured as they are.
+int scale_exponent_for(double extent) {
+  if (!(extent > 0.0) || !std::isfinite(extent) || (extent >= 0x1p-100 && extent <= 0x1p100))
+    return 0;
+  int exponent = 0;
+  std::frexp(extent, &exponent);  // extent = m 2^exponent, m in [0.5, 1)
+  return -exponent;
 }
 
 /// Features of a triangle: vertex k (corner k), edge k (corner k to k + 1), or the face.
@@ -349,7 +375,7 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
     double moved2 = 0.0;
     bool finite = true;
     for (int32_t v = 0; v < vertex_count_; ++v) {
-      const geom::Vec3d d = obstacle_positions[v] - positions_[v];
+      const geom::Vec3d d = obstacle_positions[v] - scaled(positions_[v], -scale_exponent_);
       const double d2 = geom::dot(d, d);
       finite &= std::isfinite(d2);
       moved2 = std::max(moved2, d2);
@@ -360,7 +386,10 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
   extent_ = 0.0;
   for (const geom::Vec3d& v : obstacle_positions)
     extent_ = std::max({extent_, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  scale_exponent_ = scale_exponent_for(extent_);
   positions_.assign(obstacle_positions.begin(), obstacle_positions.end());
+  if (scale_exponent_ != 0)
+    for (geom::Vec3d& v : positions_) v = scaled(v, scale_exponent_);
   face_normal_.resize(triangles_.size());
   vertex_normal_.resize(positions_.size());
   const geom::Vec3d* p = positions_.data();
@@ -389,7 +418,7 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
     const geom::Tri tri = tris[t];
     six_volume += geom::dot(p[tri.v[0]], geom::cross(p[tri.v[1]], p[tri.v[2]]));
   }
-  enclosed_volume_ = six_volume / 6.0;
+  enclosed_volume_ = std::ldexp(six_volume / 6.0, -3 * scale_exponent_);
   const mesh::MeshView mesh = mesh::view_of(positions_, triangles_);
   if (!built_) {
     tree_.build(mesh, threads);
@@ -431,6 +460,7 @@ PenetrationStats PenetrationMeter::measure_points(std::span<const geom::Vec3d> p
   geom::Vec3d* anchor = clearance ? clearance->anchor.data() : nullptr;
   double* reach = clearance ? clearance->reach.data() : nullptr;
   const double travel = travel_;
+  const int scale_exponent = scale_exponent_;
   int64_t proven_outside = 0;
   // Dynamic chunks: points near the surface cost more than points far from it.
 #pragma omp parallel for num_threads(thread_count(threads)) schedule(dynamic, 256) \
@@ -443,7 +473,9 @@ PenetrationStats PenetrationMeter::measure_points(std::span<const geom::Vec3d> p
         continue;  // out[i] stays 0
       }
     }
-    const Reading r = read_point(point[i], surface);
+    Reading r = read_point(scaled(point[i], scale_exponent), surface);
+    r.distance = std::ldexp(r.distance, -scale_exponent);
+    r.depth = std::ldexp(r.depth, -scale_exponent);
     out[i] = r.depth;
     if (reach) {
       // Only an outside point at a positive, finite distance proves anything later. The

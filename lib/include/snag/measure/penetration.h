@@ -140,13 +140,18 @@ class PenetrationMeter {
                                             ///< from corner k to corner k + 1 (mod 3)
   std::vector<int32_t> corner_begin_;       ///< vertex_count + 1: CSR offsets into corners_
   std::vector<int32_t> corners_;            ///< 3 per triangle: corners (3 t + k) by vertex
-  std::vector<geom::Vec3d> positions_;      ///< this frame's obstacle positions
+  std::vector<geom::Vec3d> positions_;      ///< this frame's obstacle positions, times
+                                            ///< 2^scale_exponent_ (the tree's, the normals')
   std::vector<geom::Vec3d> face_normal_;    ///< unit (zero for a zero-area triangle)
   std::vector<geom::Vec3d> vertex_normal_;  ///< angle-weighted sums of unit face normals
   bvh::Tree tree_{bvh::LeafBoxes::every_triangle};
   double enclosed_volume_ = 0;
   double travel_ = 0;
   double extent_ = 0;  ///< the largest coordinate magnitude of the positions, for the margin
+  /// 0, or for an obstacle whose extent is past 2^100 or under 2^-100 the power of two that
+  /// brings it to about 1: the measure works on positions and points scaled by it (exactly, a
+  /// power of two) and scales distances back, so that no square or volume overflows.
+  int scale_exponent_ = 0;
   bool built_ = false;
 
   PenetrationStats measure_points(std::span<const geom::Vec3d> points, Clearance* clearance,
