@@ -246,7 +246,10 @@ void readers_table(const std::vector<ReaderCase>& cases, int passes) {
         (void)sink;
         rates.push_back(bytes / seconds_since(started) / 1e6);
       }
-      std::printf(" %13.0f", median(rates));
+      // Whole MB/s, but a rate under 10 (a sanitizer's build, a slow disk) keeps a digit or
+      // three after the point rather than printing 0.
+      const double rate = median(rates);
+      std::printf(" %13.*f", rate >= 10 ? 0 : rate >= 0.1 ? 1 : 3, rate);
       std::fflush(stdout);
     }
     std::printf("\n");
