@@ -134,8 +134,9 @@ void add_data_case(std::vector<BenchCase>& cases, const std::filesystem::path& d
   } else if (!given.empty()) {
     throw UsageError("--data " + given + ": no " + folder + " folder in it");
   } else {
-    std::cerr << command << ": no shared data folder (" << dir.string() << "); the " << name
-              << " case is left out\n";
+    std::cerr << command << ": no "
+              << (data.empty() ? std::string("shared data folder") : dir.string()) << "; the "
+              << name << " case is left out\n";
   }
 }
 

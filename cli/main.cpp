@@ -147,6 +147,7 @@ int main(int argc, char** argv) {
     if (status < 0) throw snag::InternalError("no subcommand ran");
     // A summary that never reached its reader (a full disk, a closed file) is no success: a
     // gate reading it would see nothing, or half of it.
+    errno = 0;  // what a failing flush leaves is its own error; an earlier one's is not told
     std::cout.flush();
     if (!std::cout) {
       const int err = errno;

@@ -155,8 +155,7 @@ TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
 
 // --frames naming frames the sequence lacks (a cache with a frame missing, or cut short), or a
 // sequence that skips a number: the frames there are checked, and a warning names the ones
-// that are not; a broken link
-// among the frames is an input error naming it.
+// that are not; a broken link among the frames is an input error naming it.
 TEST(CliCheck, FramesTheSequenceLacksAreNamed) {
   TempDir tmp;
   const fs::path seq = write_hand_built_sequence(tmp.path() / "seq");

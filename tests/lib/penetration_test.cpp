@@ -302,15 +302,28 @@ TEST(Penetration, DepthsScaleWithTheCoordinatesAtEveryMagnitude) {
     for (Vec3d& v : scaled_surface.positions) v = scale * v;
     std::vector<Vec3d> scaled_points = points;
     for (Vec3d& p : scaled_points) p = scale * p;
-    const PenetrationMeter meter = meter_for(scaled_surface);
-    EXPECT_GE(meter.enclosed_volume(), 0.0);  // 0 where scale^3 underflows
-    std::vector<double> depths;
-    const PenetrationStats stats = meter.measure(scaled_points, 2, &depths);
-    EXPECT_EQ(stats.inside, base_stats.inside);
-    for (size_t i = 0; i < points.size(); ++i) {
-      ASSERT_EQ(depths[i] > 0.0, base[i] > 0.0) << "point " << i;
-      ASSERT_NEAR(depths[i] / scale, base[i], 1e-12) << "point " << i;
+    PenetrationMeter meter = meter_for(scaled_surface);
+    EXPECT_GT(meter.enclosed_volume(), 0.0);  // its sign kept where scale^3 underflows
+    // A second frame, the same positions, through a Clearance: the same depths, and the
+    // points proven outside by the first are skipped.
+    Clearance clearance;
+    for (int frame = 0; frame < 2; ++frame) {
+      if (frame == 1) meter.update_positions(scaled_surface.positions, 2);
+      std::vector<double> depths;
+      const PenetrationStats stats = meter.measure(scaled_points, clearance, 2, &depths);
+      EXPECT_EQ(stats.inside, base_stats.inside);
+      EXPECT_EQ(stats.proven_outside > 0, frame == 1);
+      for (size_t i = 0; i < points.size(); ++i) {
+        ASSERT_EQ(depths[i] > 0.0, base[i] > 0.0) << "point " << i << " frame " << frame;
+        ASSERT_NEAR(depths[i] / scale, base[i], 1e-12) << "point " << i << " frame " << frame;
+      }
     }
+    // Inside out, however small: the volume says so.
+    Surface reversed = scaled_surface;
+    for (Tri& t : reversed.triangles) std::swap(t.v[1], t.v[2]);
+    PenetrationMeter reversed_meter(reversed.triangles, reversed.vertex_count());
+    reversed_meter.update_positions(reversed.positions, 2);
+    EXPECT_LT(reversed_meter.enclosed_volume(), 0.0);
   }
 }
 

@@ -160,19 +160,9 @@ std::optional<std::string> analyse(std::span<const geom::Tri> triangles, int32_t
 // ---------------------------------------------------------------------------------------------
 // Geometry of one query.
 
-/// v's direction, or zero for a zero (or not finite) v. A vector whose squared length would
-/// underflow or overflow (the normal of a feature 1e-100 across) is divided by its largest
-/// component first, so that it still has one.
 geom::Vec3d unit_or_zero(geom::Vec3d v) {
-  const double length2 = geom::dot(v, v);
-  if (length2 >= std::numeric_limits<double>::min() &&
-      length2 < std::numeric_limits<double>::infinity())
-    return (1.0 / std::sqrt(length2)) * v;
-  const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-  if (!(largest > 0.0 && largest < std::numeric_limits<double>::infinity()))
-    return geom::Vec3d{0.0, 0.0, 0.0};
-  const geom::Vec3d w{v.x / largest, v.y / largest, v.z / largest};
-  return (1.0 / std::sqrt(geom::dot(w, w))) * w;
+  const double length = std::sqrt(geom::dot(v, v));
+  return length > 0.0 ? (1.0 / length) * v : geom::Vec3d{0.0, 0.0, 0.0};
 }
 
 /// p * 2^exponent, exactly (barring underflow to subnormals).
@@ -418,7 +408,11 @@ void PenetrationMeter::update_positions(std::span<const geom::Vec3d> obstacle_po
     const geom::Tri tri = tris[t];
     six_volume += geom::dot(p[tri.v[0]], geom::cross(p[tri.v[1]], p[tri.v[2]]));
   }
+  // Scaled back; where that underflows (an obstacle under ~1e-108), the sign is kept: it says
+  // whether the surface is inside out.
   enclosed_volume_ = std::ldexp(six_volume / 6.0, -3 * scale_exponent_);
+  if (enclosed_volume_ == 0.0 && six_volume != 0.0)
+    enclosed_volume_ = std::copysign(std::numeric_limits<double>::denorm_min(), six_volume);
   const mesh::MeshView mesh = mesh::view_of(positions_, triangles_);
   if (!built_) {
     tree_.build(mesh, threads);

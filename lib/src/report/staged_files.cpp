@@ -190,7 +190,8 @@ void StagedFiles::commit() {
       untrack(std::exchange(e.tracked_slot, -1));
     }
   // Every final name checked again before the first rename (a directory made there since
-  // create()): what can still fail between two renames is the directory itself going.
+  // create()). What can still fail between two renames (staged_files.h): the directory going
+  // or made read-only, or a directory made at a later name in the microseconds between.
   for (const Entry& e : entries_)
     if (!e.scratch) require_replaceable(e.file->final_path());
   for (Entry& e : entries_) {

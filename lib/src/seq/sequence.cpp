@@ -232,8 +232,8 @@ std::string other_width_hint(const fs::path& dir, const FramePattern& pattern,
     const std::string name = file.filename().string();
     if (name.size() <= pattern.prefix.size() + pattern.suffix.size() ||
         name.compare(0, pattern.prefix.size(), pattern.prefix) != 0 ||
-        name.compare(name.size() - pattern.suffix.size(), pattern.suffix.size(),
-                     pattern.suffix) != 0)
+        name.compare(name.size() - pattern.suffix.size(), pattern.suffix.size(), pattern.suffix) !=
+            0)
       continue;
     const std::string_view digits = std::string_view(name).substr(
         pattern.prefix.size(), name.size() - pattern.prefix.size() - pattern.suffix.size());
@@ -465,7 +465,9 @@ FrameGaps frame_gaps(const std::vector<Frame>& frames, size_t most_runs) {
   gaps.step = static_cast<int64_t>(step);
   const FrameSelection grid = FrameSelection::parse(
       std::to_string(gaps.first) + "-" + std::to_string(gaps.last) + "x" + std::to_string(step));
-  gaps.runs = grid.absent_runs(frames, most_runs);
+  gaps.runs = grid.absent_runs(frames, most_runs + 1);
+  gaps.more = gaps.runs.size() > most_runs;
+  if (gaps.more) gaps.runs.pop_back();
   return gaps;
 }
 

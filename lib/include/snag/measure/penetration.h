@@ -127,7 +127,8 @@ class PenetrationMeter {
 
   /// The signed volume the surface encloses at the last update_positions() (0 before): positive
   /// when its triangles face outward, negative when the surface is inside out (then measure()
-  /// reports the points outside it as inside; callers may warn).
+  /// reports the points outside it as inside; callers may warn). For a surface so small that
+  /// its volume underflows, the smallest double of that sign.
   double enclosed_volume() const { return enclosed_volume_; }
 
   int32_t triangle_count() const { return static_cast<int32_t>(triangles_.size()); }

@@ -32,6 +32,7 @@ struct ResolvedScene {
   /// (seq::FrameSelection::absent_runs, at most kMostAbsentRuns): a cache cut short or with a
   /// frame missing, which the user is told of.
   std::vector<std::string> absent_frames;
+  bool more_absent_frames = false;  ///< more runs are absent than absent_frames holds
   static constexpr size_t kMostAbsentRuns = 6;
   /// Without --frames: the numbers the first cloth's sequence skips (seq::frame_gaps, at most
   /// kMostAbsentRuns runs), a frame a cache lost, which the user is told of.

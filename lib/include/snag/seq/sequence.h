@@ -75,6 +75,7 @@ struct FrameGaps {
   int64_t step = 0;             ///< the grid's step (0 when there are no runs to find)
   /// The missing numbers as runs ("4", "6-7", "10-30x5"), at most `most_runs` of them.
   std::vector<std::string> runs;
+  bool more = false;  ///< more runs are missing than `runs` holds
 };
 
 /// The gaps of `frames` (in increasing number, each number once, as resolve_sequence returns
