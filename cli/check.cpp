@@ -97,6 +97,14 @@ std::vector<report::ObjectInput> object_inputs(const scene::ResolvedScene& scene
   return objects;
 }
 
+/// Runs of frame numbers for a warning: "2, 5-6", and ", ..." when `more` were left out.
+std::string joined_runs(const std::vector<std::string>& runs, bool more) {
+  std::string joined;
+  for (const std::string& run : runs) (joined += joined.empty() ? "" : ", ") += run;
+  if (more) joined += ", ...";
+  return joined;
+}
+
 /// The --out directory, made ready (report::prepare_output_dir), and those of it and its
 /// parents that this run created: removed again while empty when the run fails, so that a
 /// failed run leaves nothing behind where there was nothing. (Not on a signal: the handler
@@ -390,22 +398,17 @@ int run_check(const CheckOptions& o) {
   if (!resolved.absent_frames.empty()) {
     // Not an error: a selection may reach past a cache on purpose. But a gate should not pass
     // frames it never saw in silence.
-    std::string runs;
-    for (const std::string& run : resolved.absent_frames) runs += (runs.empty() ? "" : ", ") + run;
-    if (resolved.more_absent_frames) runs += ", ...";
-    warn("--frames " + o.frames + " names frames the sequence does not have (" + runs +
+    warn("--frames " + o.frames + " names frames the sequence does not have (" +
+         joined_runs(resolved.absent_frames, resolved.more_absent_frames) +
          "); they are not checked");
   }
   if (!resolved.gaps.runs.empty()) {
     // A frame lost from a cache (a failed write, a partial copy) would otherwise pass unseen.
     const seq::FrameGaps& gaps = resolved.gaps;
-    std::string runs;
-    for (const std::string& run : gaps.runs) runs += (runs.empty() ? "" : ", ") + run;
-    if (gaps.more) runs += ", ...";
     const std::string grid = gaps.step == 1 ? "" : ", counting by " + std::to_string(gaps.step);
-    warn("the sequence skips frame numbers " + runs + " (between its first frame, " +
-         std::to_string(gaps.first) + ", and its last, " + std::to_string(gaps.last) + grid +
-         "); only the frames present are checked");
+    warn("the sequence skips frame numbers " + joined_runs(gaps.runs, gaps.more) +
+         " (between its first frame, " + std::to_string(gaps.first) + ", and its last, " +
+         std::to_string(gaps.last) + grid + "); only the frames present are checked");
   }
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at

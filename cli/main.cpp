@@ -55,6 +55,31 @@ void take_the_last_of_repeated_options(CLI::App& app) {
     take_the_last_of_repeated_options(*command);
 }
 
+/// The names of `app`'s commands, for a message: "check or bench", "cpu, gpu, accuracy, io or
+/// scene".
+std::string command_names(const CLI::App& app) {
+  const std::vector<const CLI::App*> commands = app.get_subcommands({});
+  std::string names;
+  for (size_t i = 0; i < commands.size(); ++i) {
+    names += i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ";
+    names += commands[i]->get_name();
+  }
+  return names;
+}
+
+/// `status`, once what is buffered for standard output has been written; 3 when it could not
+/// be (a full disk, a closed file): a summary or help that never reached its reader is no
+/// success, and a gate reading it would see nothing, or half of it.
+int status_once_output_is_written(int status) {
+  errno = 0;  // what a failing flush leaves is its own error; an earlier one's is not told
+  std::cout.flush();
+  if (std::cout) return status;
+  const int err = errno;
+  std::cerr << "snag: cannot write to standard output"
+            << (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) << "\n";
+  return 3;
+}
+
 /// CLI11's message for a command line whose command or benchmark is missing or misspelt ("A
 /// subcommand is required", also for `snag --bogus`): what was expected, and what was found.
 /// `app` is the top-level app, whatever level failed: the one that failed is the deepest
@@ -65,12 +90,7 @@ std::string failure_text(const CLI::App* app, const CLI::Error& error) {
     return CLI::FailureMessage::simple(app, error);
   const CLI::App* failed = app;
   while (!failed->get_subcommands().empty()) failed = failed->get_subcommands().front();
-  const std::vector<const CLI::App*> commands = failed->get_subcommands({});
-  std::string expected;
-  for (size_t i = 0; i < commands.size(); ++i) {
-    expected += i == 0 ? "" : i + 1 == commands.size() ? " or " : ", ";
-    expected += commands[i]->get_name();
-  }
+  const std::string expected = command_names(*failed);
   const std::vector<std::string> left = failed->remaining();
   std::string found = "nothing";
   if (!left.empty())
@@ -134,8 +154,8 @@ int main(int argc, char** argv) {
       return false;
     };
     if (argc > 1 && argv[1][0] != '-' && !names_a_command(argv[1]))
-      throw snag::UsageError("unknown command '" + std::string(argv[1]) +
-                             "'; expected check or bench");
+      throw snag::UsageError("unknown command '" + std::string(argv[1]) + "'; expected " +
+                             command_names(app));
     app.parse(argc, argv);
     int status = -1;
     if (check_command->parsed()) status = snag::cli::run_check(check);
@@ -145,25 +165,11 @@ int main(int argc, char** argv) {
     if (bench_io_command->parsed()) status = snag::cli::run_bench_io(bench_io);
     if (bench_scene_command->parsed()) status = snag::cli::run_bench_scene(bench_scene);
     if (status < 0) throw snag::InternalError("no subcommand ran");
-    // A summary that never reached its reader (a full disk, a closed file) is no success: a
-    // gate reading it would see nothing, or half of it.
-    errno = 0;  // what a failing flush leaves is its own error; an earlier one's is not told
-    std::cout.flush();
-    if (!std::cout) {
-      const int err = errno;
-      std::cerr << "snag: cannot write to standard output"
-                << (err != 0 ? std::string(": ") + std::strerror(err) : std::string()) << "\n";
-      return 3;
-    }
-    return status;
+    return status_once_output_is_written(status);
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with CLI11's success code.
     const int code = app.exit(e);
-    if (code == 0 && !std::cout.flush()) {
-      std::cerr << "snag: cannot write to standard output\n";
-      return 3;
-    }
-    return code == 0 ? 0 : 2;
+    return code == 0 ? status_once_output_is_written(0) : 2;
   } catch (const snag::UsageError& e) {
     std::cerr << "snag: error: " << e.what() << "\nRun with --help for more information.\n";
     return 2;

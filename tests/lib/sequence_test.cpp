@@ -349,6 +349,14 @@ TEST(AbsentRuns, NamesTheNumbersTheSequenceLacks) {
   EXPECT_EQ(FrameSelection::parse("100-200").absent_runs(frames, 6), (Runs{"100-200"}));
   EXPECT_EQ(FrameSelection::parse("0-12").absent_runs(frames, 2), (Runs{"0", "3"}));
   EXPECT_EQ(FrameSelection::parse("3,3").absent_runs(frames, 6), (Runs{"3"}));  // once
+  // Whether runs were left out past the most asked for (a run named twice counts once).
+  bool more = false;
+  EXPECT_EQ(FrameSelection::parse("0-12").absent_runs(frames, 2, &more), (Runs{"0", "3"}));
+  EXPECT_TRUE(more);
+  EXPECT_EQ(FrameSelection::parse("0-12").absent_runs(frames, 4, &more).size(), 4u);
+  EXPECT_FALSE(more);
+  EXPECT_EQ(FrameSelection::parse("3,3").absent_runs(frames, 1, &more), (Runs{"3"}));
+  EXPECT_FALSE(more);
   // Numbers at the ends of int64 do not overflow.
   const int64_t most = std::numeric_limits<int64_t>::max();
   const std::vector<Frame> far = {{most - 1, "x"}};

@@ -132,10 +132,8 @@ ResolvedScene resolve_scene(const Scene& scene, std::string_view frame_selection
   resolved.frames = resolved.objects[driver_index].frames;
   if (!frame_selection.empty()) {
     const seq::FrameSelection selection = seq::FrameSelection::parse(frame_selection);
-    resolved.absent_frames =
-        selection.absent_runs(resolved.frames, ResolvedScene::kMostAbsentRuns + 1);
-    resolved.more_absent_frames = resolved.absent_frames.size() > ResolvedScene::kMostAbsentRuns;
-    if (resolved.more_absent_frames) resolved.absent_frames.pop_back();
+    resolved.absent_frames = selection.absent_runs(resolved.frames, ResolvedScene::kMostAbsentRuns,
+                                                   &resolved.more_absent_frames);
     resolved.frames = seq::select_frames(resolved.frames, selection);
   } else {
     resolved.gaps = seq::frame_gaps(resolved.frames, ResolvedScene::kMostAbsentRuns);

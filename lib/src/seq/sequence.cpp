@@ -108,15 +108,21 @@ std::string_view last_digit_run(std::string_view stem) {
   return stem.substr(begin, end - begin);
 }
 
+/// What stands in `name` where the pattern's token is: the non-empty text between its prefix
+/// and its suffix, or nothing when the name does not have them.
+std::optional<std::string_view> token_text(std::string_view name, const FramePattern& pat) {
+  if (name.size() <= pat.prefix.size() + pat.suffix.size() || !name.starts_with(pat.prefix) ||
+      !name.ends_with(pat.suffix))
+    return std::nullopt;
+  return name.substr(pat.prefix.size(), name.size() - pat.prefix.size() - pat.suffix.size());
+}
+
 /// Matches `name` against the pattern; the frame number on success.
 std::optional<int64_t> match_frame_pattern(const std::string& name, const FramePattern& pat,
                                            const std::string& path) {
-  if (name.size() <= pat.prefix.size() + pat.suffix.size()) return std::nullopt;
-  if (name.compare(0, pat.prefix.size(), pat.prefix) != 0) return std::nullopt;
-  if (name.compare(name.size() - pat.suffix.size(), pat.suffix.size(), pat.suffix) != 0)
-    return std::nullopt;
-  const std::string_view middle = std::string_view(name).substr(
-      pat.prefix.size(), name.size() - pat.prefix.size() - pat.suffix.size());
+  const std::optional<std::string_view> token = token_text(name, pat);
+  if (!token) return std::nullopt;
+  const std::string_view middle = *token;
   const bool negative = middle[0] == '-';
   const std::string_view digits = middle.substr(negative ? 1 : 0);
   if (digits.empty() || !std::all_of(digits.begin(), digits.end(), is_digit)) return std::nullopt;
@@ -230,20 +236,14 @@ std::string other_width_hint(const fs::path& dir, const FramePattern& pattern,
                              const std::string& sequence) {
   for (const fs::path& file : list_files(dir, sequence)) {
     const std::string name = file.filename().string();
-    if (name.size() <= pattern.prefix.size() + pattern.suffix.size() ||
-        name.compare(0, pattern.prefix.size(), pattern.prefix) != 0 ||
-        name.compare(name.size() - pattern.suffix.size(), pattern.suffix.size(), pattern.suffix) !=
-            0)
-      continue;
-    const std::string_view digits = std::string_view(name).substr(
-        pattern.prefix.size(), name.size() - pattern.prefix.size() - pattern.suffix.size());
-    if (!std::all_of(digits.begin(), digits.end(), is_digit)) continue;
+    const std::optional<std::string_view> digits = token_text(name, pattern);
+    if (!digits || !std::all_of(digits->begin(), digits->end(), is_digit)) continue;
     std::string hint = "; '";
     hint += name;
-    if (digits.size() > 1 && digits[0] == '0') {
-      const std::string width = std::to_string(digits.size());
+    if (digits->size() > 1 && digits->front() == '0') {
+      const std::string width = std::to_string(digits->size());
       hint += "' has its frame number padded to " + width + " digits: write %0" + width + "d, " +
-              std::string(digits.size(), '#') + " or $F" + width;
+              std::string(digits->size(), '#') + " or $F" + width;
     } else {
       hint += "' has its frame number unpadded: write %d, # or $F";
     }
@@ -408,16 +408,23 @@ bool FrameSelection::contains(int64_t frame) const {
 }
 
 std::vector<std::string> FrameSelection::absent_runs(const std::vector<Frame>& frames,
-                                                     size_t most_runs) const {
+                                                     size_t most_runs, bool* more) const {
   std::vector<std::string> runs;
+  if (more) *more = false;
   if (all_) return runs;
   // A run of the item's numbers from `from` to `to` (both on its grid), when there is one.
   const auto add_run = [&](int64_t from, int64_t to, int64_t step) {
-    if (from > to || runs.size() >= most_runs) return;
+    if (from > to) return;
+    const bool full = runs.size() >= most_runs;
+    if (full && (!more || *more)) return;  // nothing left to learn
     std::string run = std::to_string(from);
     if (to != from) (run += '-') += std::to_string(to);
     if (to != from && step != 1) (run += 'x') += std::to_string(step);
-    if (std::find(runs.begin(), runs.end(), run) == runs.end()) runs.push_back(run);
+    if (std::find(runs.begin(), runs.end(), run) != runs.end()) return;  // named once
+    if (full)
+      *more = true;
+    else
+      runs.push_back(run);
   };
   for (const Range& r : ranges_) {
     const auto step = static_cast<uint64_t>(r.step);
@@ -465,9 +472,7 @@ FrameGaps frame_gaps(const std::vector<Frame>& frames, size_t most_runs) {
   gaps.step = static_cast<int64_t>(step);
   const FrameSelection grid = FrameSelection::parse(
       std::to_string(gaps.first) + "-" + std::to_string(gaps.last) + "x" + std::to_string(step));
-  gaps.runs = grid.absent_runs(frames, most_runs + 1);
-  gaps.more = gaps.runs.size() > most_runs;
-  if (gaps.more) gaps.runs.pop_back();
+  gaps.runs = grid.absent_runs(frames, most_runs, &gaps.more);
   return gaps;
 }
 

@@ -54,8 +54,10 @@ class FrameSelection {
   bool selects_all() const { return all_; }
   /// The numbers this selection names that `frames` (in increasing number) lacks, as runs
   /// ("7", "20-30", "1-240x5"), each item's runs in order, at most `most_runs` of them; empty
-  /// when every number named is a frame (or the selection selects all).
-  std::vector<std::string> absent_runs(const std::vector<Frame>& frames, size_t most_runs) const;
+  /// when every number named is a frame (or the selection selects all). `more`, when given, is
+  /// set to whether more runs are absent than were returned.
+  std::vector<std::string> absent_runs(const std::vector<Frame>& frames, size_t most_runs,
+                                       bool* more = nullptr) const;
   const std::string& text() const { return text_; }
 
  private:
