@@ -326,7 +326,8 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
 int run_bench_accuracy(const BenchAccuracyOptions& o) {
   const int threads = thread_count(o.threads);
   const char* command = "snag bench accuracy";
-  if (!o.out_dir.empty()) report::prepare_output_dir(o.out_dir);
+  std::optional<report::OutputDirectory> output_directory;
+  if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
 
   std::vector<Input> inputs;
   const fs::path hard = o.hard_dir.empty() ? default_hard_dir() : fs::path(o.hard_dir);
@@ -410,7 +411,10 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
                 s.seconds * 1e3, static_cast<long long>(s.pairs),
                 static_cast<long long>(s.false_positive), static_cast<long long>(s.false_negative),
                 kinds_cell(s).c_str(), static_cast<long long>(s.unproven));
-  if (!o.out_dir.empty()) write_tables(scores, o.out_dir, header);
+  if (output_directory) {
+    write_tables(scores, o.out_dir, header);
+    output_directory->keep();
+  }
   return 0;
 }
 

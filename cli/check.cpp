@@ -105,43 +105,6 @@ std::string joined_runs(const std::vector<std::string>& runs, bool more) {
   return joined;
 }
 
-/// The --out directory, made ready (report::prepare_output_dir), and those of it and its
-/// parents that this run created: removed again while empty when the run fails, so that a
-/// failed run leaves nothing behind where there was nothing. (Not on a signal: the handler
-/// removes the report temporaries only.) A path through ".." is made but never removed: what
-/// it names is not what its spelling's prefixes name (a link, or "x/.." made from nothing).
-class OutputDirectory {
- public:
-  explicit OutputDirectory(const std::filesystem::path& dir) {
-    const bool climbs = std::any_of(dir.begin(), dir.end(),
-                                    [](const std::filesystem::path& part) { return part == ".."; });
-    std::error_code ec;
-    std::filesystem::path path = std::filesystem::absolute(dir, ec);
-    if (!ec && path.filename().empty()) path = path.parent_path();  // "out/"
-    for (; !climbs && !ec && path.has_relative_path() && !std::filesystem::exists(path, ec);
-         path = path.parent_path())
-      created_.push_back(path);  // deepest first
-    try {
-      report::prepare_output_dir(dir);
-    } catch (...) {
-      remove_created();
-      throw;
-    }
-  }
-  ~OutputDirectory() { remove_created(); }
-  OutputDirectory(const OutputDirectory&) = delete;
-  OutputDirectory& operator=(const OutputDirectory&) = delete;
-  /// The run succeeded: the directory holds its reports.
-  void keep() { created_.clear(); }
-
- private:
-  void remove_created() {
-    std::error_code ignored;  // a directory no longer empty (another run's reports) stays
-    for (const std::filesystem::path& path : created_) std::filesystem::remove(path, ignored);
-  }
-  std::vector<std::filesystem::path> created_;
-};
-
 /// Frames in which every triangle of an object has zero area: a cache frame written with its
 /// vertices zeroed, or a simulation collapsed to a point. Its faces pair with nothing, so the
 /// frame checks clean and a gate would pass it in silence. The objects of the first kNamed such
@@ -413,7 +376,7 @@ int run_check(const CheckOptions& o) {
   const bool scene_run = !o.scene.empty() || o.split_groups || !o.obstacles.empty();
   // The output directory is checked before the first frame, so an unusable --out fails at
   // once rather than after an hour of checking.
-  std::optional<OutputDirectory> output_directory;
+  std::optional<report::OutputDirectory> output_directory;
   if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
 
   // The run's threads are the checker's and its readers' (checker_threads_for).

@@ -566,6 +566,26 @@ TEST(ReportWrite, OutputPathIsAFile) {
   EXPECT_EQ(entries(tmp.path()), (std::vector<std::string>{"not-a-dir"}));
 }
 
+// The directories a run made for its reports go again unless it kept them; one that was there
+// stays; a path through ".." is never removed.
+TEST(ReportWrite, OutputDirectoryRemovesWhatItMadeUnlessKept) {
+  TempDir tmp;
+  { OutputDirectory dir(tmp.path() / "new" / "reports"); }
+  EXPECT_EQ(entries(tmp.path()), std::vector<std::string>{});
+  {
+    OutputDirectory dir(tmp.path() / "kept" / "reports");
+    dir.keep();
+  }
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "kept" / "reports"));
+  { OutputDirectory dir(tmp.path() / "kept" / "more/"); }
+  EXPECT_EQ(entries(tmp.path() / "kept"), std::vector<std::string>{"reports"});
+  { OutputDirectory dir(tmp.path() / "x" / ".." / "y"); }
+  EXPECT_TRUE(fs::is_directory(tmp.path() / "y"));
+  // Failing to prepare: a WriteError, as prepare_output_dir's.
+  std::ofstream(tmp.path() / "file") << "x";
+  EXPECT_THROW(OutputDirectory(tmp.path() / "file" / "below"), WriteError);
+}
+
 TEST(ReportWrite, OutputPathUnderAFile) {
   TempDir tmp;
   std::ofstream(tmp.path() / "file") << "x";

@@ -29,6 +29,32 @@ void prepare_output_dir(const fs::path& dir) {
   remove_quietly(probe);
 }
 
+OutputDirectory::OutputDirectory(const fs::path& dir) {
+  const bool climbs =
+      std::any_of(dir.begin(), dir.end(), [](const fs::path& part) { return part == ".."; });
+  std::error_code ec;
+  fs::path path = fs::absolute(dir, ec);
+  if (!ec && path.filename().empty()) path = path.parent_path();  // "out/"
+  for (; !climbs && !ec && path.has_relative_path() && !fs::exists(path, ec);
+       path = path.parent_path())
+    created_.push_back(path);
+  try {
+    prepare_output_dir(dir);
+  } catch (...) {
+    remove_created();
+    throw;
+  }
+}
+
+OutputDirectory::~OutputDirectory() {
+  remove_created();
+}
+
+void OutputDirectory::remove_created() noexcept {
+  std::error_code ignored;  // a directory no longer empty (another run's reports) stays
+  for (const fs::path& path : created_) fs::remove(path, ignored);
+}
+
 void write_files_atomically(const fs::path& dir, const std::vector<OutputFile>& files) {
   StagedFiles staged(dir);
   for (const OutputFile& file : files) {

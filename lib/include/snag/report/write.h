@@ -41,6 +41,27 @@ void write_files_atomically(const std::filesystem::path& dir, const std::vector<
 /// does not fail at its end); creates it. Throws WriteError otherwise.
 void prepare_output_dir(const std::filesystem::path& dir);
 
+/// The output directory of a run, made ready (prepare_output_dir), and those of it and its
+/// parents that the run created: removed again while empty unless keep() is called (the run
+/// failed), so that a failed run leaves nothing behind where there was nothing. (Not on a
+/// signal: the handler removes the report temporaries only.) A path through ".." is made but
+/// never removed: what it names is not what its spelling's prefixes name (a link, or "x/.."
+/// made from nothing). Throws WriteError as prepare_output_dir does, having removed what it
+/// made.
+class OutputDirectory {
+ public:
+  explicit OutputDirectory(const std::filesystem::path& dir);
+  ~OutputDirectory();
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+  /// The run succeeded: the directory holds its reports.
+  void keep() { created_.clear(); }
+
+ private:
+  void remove_created() noexcept;
+  std::vector<std::filesystem::path> created_;  ///< deepest first
+};
+
 /// Removes every report temporary of this process that may be on disk (written, not yet
 /// renamed into place or removed); finished reports are not touched. Async-signal-safe (atomic
 /// loads and unlink): for a handler of SIGINT or SIGTERM, so that a run killed midway leaves no
