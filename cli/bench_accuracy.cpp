@@ -377,7 +377,8 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
   if (inputs.empty()) throw UsageError("snag bench accuracy: no inputs");
 
   std::vector<std::string> backends = {"cpu"};
-  if (cuda_devices() > 0) backends.push_back("cuda");
+  const bool with_cuda = resolve_auto_backend(0, nullptr) == "cuda";
+  if (with_cuda) backends.push_back("cuda");
   std::vector<Method> methods;
   for (const std::string& backend : backends)
     for (detect::ExactMode mode :
@@ -395,10 +396,11 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
   }
 
   char header[256];
-  std::snprintf(header, sizeof header,
-                "snag bench accuracy: %d threads, %s; ms/frame is the median over the input's "
-                "frames; wrong counts are summed over them, against snag --exact all (CGAL-confirmed)",
-                threads, cuda_devices() > 0 ? "CPU and CUDA" : "CPU only (no CUDA device)");
+  std::snprintf(
+      header, sizeof header,
+      "snag bench accuracy: %d threads, %s; ms/frame is the median over the input's "
+      "frames; wrong counts are summed over them, against snag --exact all (CGAL-confirmed)",
+      threads, with_cuda ? "CPU and CUDA" : "CPU only (no usable CUDA device)");
   // The input column as wide as its longest name (a file given with --input can be long).
   int input_width = 28;
   for (const Score& s : scores)

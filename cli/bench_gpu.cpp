@@ -336,9 +336,12 @@ void print_tables(const std::vector<Row>& rows, const std::string& device, int t
 }  // namespace
 
 int run_bench_gpu(const BenchGpuOptions& o) {
-  if (cuda_devices() == 0)
-    throw DeviceUnavailable(
-        "bench gpu: no CUDA device is usable here (no NVIDIA GPU, or no driver for it)");
+  if (cuda_devices() == 0) {
+    const std::string problem = cuda_runtime_problem();
+    throw DeviceUnavailable("bench gpu: no CUDA device is usable here (" +
+                            (problem.empty() ? "no NVIDIA GPU, or no driver for it" : problem) +
+                            ")");
+  }
   ScratchDir scratch;
   std::vector<BenchCase> cases;
   const fs::path data = data_folder(o.data_dir);

@@ -614,7 +614,7 @@ int run_bench_io(const BenchIoOptions& o) {
   cycled_copies(obj, o.frames, sequence_dir);
   const std::vector<seq::Frame> frames = seq::resolve_sequence(sequence_dir.string());
   std::vector<std::string> backends = {"cpu"};
-  if (cuda_devices() > 0) backends.push_back("cuda");
+  if (resolve_auto_backend(o.device, nullptr) == "cuda") backends.push_back("cuda");
   sequence_table(cloth + " OBJ", frames, backends, threads, o.device, scratch.path() / "out");
   // Each --input of two frames or more, as it is: a studio's own cache, whose pairs (a clean
   // cache has few) decide what the reports cost.

@@ -527,8 +527,9 @@ int run_bench_scene(const BenchSceneOptions& o) {
   if (o.backend != "cuda") backends.push_back("cpu");
   if (o.backend == "both" && !cuda_built()) {
     skipped.push_back("cuda     skipped: this snag was built without the CUDA backend");
-  } else if (o.backend == "both" && cuda_devices() == 0) {
-    skipped.push_back("cuda     skipped: no CUDA device");
+  } else if (std::string why;
+             o.backend == "both" && resolve_auto_backend(o.device, &why) != "cuda") {
+    skipped.push_back("cuda     skipped: " + (why.empty() ? std::string("no CUDA device") : why));
   } else if (o.backend != "cpu") {
     make_backend("cuda", threads, o.device);  // throws DeviceUnavailable, saying why
     backends.push_back("cuda");

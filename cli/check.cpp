@@ -307,8 +307,9 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->capture_default_str();
   cmd->add_option(
          "--backend", o.backend,
-         "Detection backend: auto (the GPU when snag has CUDA and a device is present, else "
-         "the CPU), cpu, or cuda (exit status 4 when not built or no device)")
+         "Detection backend: auto (the GPU when snag has CUDA and a device that can run it is "
+         "present, else the CPU), cpu, or cuda (exit status 4 when not built, no device, or "
+         "one that cannot run it)")
       ->type_name("NAME")
       ->check(CLI::IsMember(
           std::vector<std::string>(std::begin(backend_names), std::end(backend_names))))
@@ -381,9 +382,13 @@ int run_check(const CheckOptions& o) {
 
   // The run's threads are the checker's and its readers' (checker_threads_for).
   const int threads = thread_count(o.threads);
-  const bool on_gpu = o.backend == "cuda" || (o.backend == "auto" && cuda_devices() > 0);
+  std::string backend_note;
+  const std::string_view backend_choice =
+      o.backend == "auto" ? resolve_auto_backend(o.device, &backend_note) : o.backend;
+  if (!backend_note.empty()) warn(backend_note);
+  const bool on_gpu = backend_choice == "cuda";
   const int checker_threads = checker_threads_for(threads, on_gpu);
-  auto backend = make_backend(o.backend, checker_threads, o.device);
+  auto backend = make_backend(backend_choice, checker_threads, o.device);
   const std::string backend_name(backend->name());
   detect::CheckSettings settings;
   settings.threads = checker_threads;

@@ -465,18 +465,22 @@ class CudaBackendImpl final : public CudaBackend {
   };
   FrameView current_view() const { return {current_positions_, part_versions()}; }
 
-  /// The versions of a frame whose parts moved as `moved` says (empty: all of them).
+  /// The versions of a frame whose parts moved as `moved` says (empty, or a list of another
+  /// length: all of them).
   std::vector<uint64_t> next_versions(std::span<const uint8_t> moved) {
+    const bool all = moved.size() != part_.size();
     std::vector<uint64_t> versions(part_.size());
     for (size_t p = 0; p < part_.size(); ++p)
-      versions[p] = moved.empty() || moved[p] || part_[p].version == 0 ? ++versions_issued_
-                                                                       : part_[p].version;
+      versions[p] = all || moved[p] || part_[p].version == 0 ? ++versions_issued_
+                                                             : part_[p].version;
     return versions;
   }
-  /// Whether two `moved` lists say the same of every part (an empty one: every part moved).
+  /// Whether two `moved` lists say the same of every part (an empty one, or one of another
+  /// length: every part moved).
   bool same_moved(std::span<const uint8_t> a, const std::vector<uint8_t>& b) const {
+    const bool all_a = a.size() != part_.size(), all_b = b.size() != part_.size();
     for (size_t p = 0; p < part_.size(); ++p) {
-      const bool in_a = a.empty() || a[p], in_b = b.empty() || b[p];
+      const bool in_a = all_a || a[p], in_b = all_b || b[p];
       if (in_a != in_b) return false;
     }
     return true;
@@ -1182,12 +1186,86 @@ int cuda_device_count() {
   return count;
 }
 
+namespace {
+
+std::string runtime_error_text(cudaError_t status) {
+  std::string text = cudaGetErrorName(status);
+  text += " (";
+  text += cudaGetErrorString(status);
+  text += ")";
+  return text;
+}
+
+std::string cuda_version_text(int version) {
+  return std::to_string(version / 1000) + "." + std::to_string(version % 1000 / 10);
+}
+
+/// A kernel that does nothing, compiled like every other: whether the runtime finds code of
+/// this build for a device.
+__global__ void usability_probe_kernel() {}
+
+}  // namespace
+
+std::string cuda_runtime_problem() {
+  int count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  cudaGetLastError();
+  if (status == cudaSuccess || status == cudaErrorNoDevice) return {};
+  int driver = 0;
+  if (cudaDriverGetVersion(&driver) != cudaSuccess || driver == 0) {
+    cudaGetLastError();
+    return {};  // no NVIDIA driver: a machine without a GPU
+  }
+  if (status == cudaErrorInsufficientDriver) {
+    int runtime = 0;
+    cudaRuntimeGetVersion(&runtime);
+    return "the NVIDIA driver supports CUDA " + cuda_version_text(driver) +
+           ", older than this build's CUDA runtime (" + cuda_version_text(runtime) +
+           "): update the driver";
+  }
+  return "the CUDA runtime found no usable device: " + runtime_error_text(status);
+}
+
+std::string cuda_device_problem(int device) {
+  const int count = cuda_device_count();
+  if (device < 0 || device >= count)
+    return "there is no CUDA device " + std::to_string(device) + " (" + std::to_string(count) +
+           " here)";
+  cudaDeviceProp prop{};
+  if (const cudaError_t status = cudaGetDeviceProperties(&prop, device); status != cudaSuccess) {
+    cudaGetLastError();
+    return "CUDA device " + std::to_string(device) + ": " + runtime_error_text(status);
+  }
+  const std::string which = "CUDA device " + std::to_string(device) + " (" + prop.name +
+                            ", compute capability " + std::to_string(prop.major) + "." +
+                            std::to_string(prop.minor) + ")";
+  // Creating the device's context fails for a device held by another process in exclusive
+  // mode, or set to prohibited; finding the probe's code fails for a GPU the build has none
+  // for (machine code for older architectures only runs on its own family, PTX only on its
+  // architecture and newer).
+  cudaError_t status = cudaSetDevice(device);
+  if (status == cudaSuccess) status = cudaFree(nullptr);
+  cudaFuncAttributes attributes{};
+  if (status == cudaSuccess) status = cudaFuncGetAttributes(&attributes, usability_probe_kernel);
+  if (status == cudaSuccess) return {};
+  cudaGetLastError();
+  if (status == cudaErrorNoKernelImageForDevice || status == cudaErrorInvalidDeviceFunction ||
+      status == cudaErrorUnsupportedPtxVersion)
+    return which + " cannot run this build's kernels, compiled for CUDA architectures " +
+           SNAG_CUDA_ARCHITECTURES_TEXT + ": rebuild with -DSNAG_CUDA_ARCHITECTURES=" +
+           std::to_string(prop.major) + std::to_string(prop.minor) + " (" +
+           runtime_error_text(status) + ")";
+  return which + " cannot be used: " + runtime_error_text(status);
+}
+
 std::unique_ptr<detect::Backend> make_cuda_backend(int device) {
   const int count = cuda_device_count();
   if (count == 0) throw InternalError("no CUDA device is usable here (no GPU, or no driver)");
   if (device < 0 || device >= count)
     throw InternalError("--device " + std::to_string(device) + ": there are " +
                         std::to_string(count) + " CUDA device(s), numbered from 0");
+  if (const std::string problem = cuda_device_problem(device); !problem.empty())
+    throw InternalError(problem);
   return std::make_unique<CudaBackendImpl>(device);
 }
 

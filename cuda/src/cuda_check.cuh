@@ -4,6 +4,7 @@
 
 #include <cuda_runtime.h>
 
+#include <cstddef>
 #include <string>
 
 #include "snag/error.h"
@@ -14,6 +15,23 @@ namespace snag::cuda {
                                           int line) {
   throw InternalError(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
                       cudaGetErrorName(status) + ": " + cudaGetErrorString(status));
+}
+
+/// A device allocation that did not fit: how much was asked for and how much is free, in
+/// words a user can act on (a frame with millions of candidate pairs, on a GPU that is small or
+/// shared with another job).
+[[noreturn]] inline void throw_out_of_device_memory(size_t bytes) {
+  size_t free = 0, total = 0;
+  if (cudaMemGetInfo(&free, &total) != cudaSuccess) cudaGetLastError();
+  const auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+  std::string message = "the GPU's memory is too small for this frame: a buffer of ";
+  message += mib(bytes);
+  message += " did not fit (";
+  message += mib(free);
+  message += " of ";
+  message += mib(total);
+  message += " free); check it with --backend cpu";
+  throw InternalError(message);
 }
 
 }  // namespace snag::cuda

@@ -30,7 +30,14 @@ class DeviceBuffer {
   void reserve(size_t count) {
     if (count <= capacity_) return;
     release();
-    SNAG_CUDA_CHECK(cudaMalloc(&data_, count * sizeof(T)));
+    const cudaError_t status = cudaMalloc(&data_, count * sizeof(T));
+    if (status == cudaErrorMemoryAllocation) {
+      cudaGetLastError();
+      data_ = nullptr;
+      throw_out_of_device_memory(count * sizeof(T));
+    }
+    if (status != cudaSuccess)
+      throw_cuda_error(status, "cudaMalloc(&data_, count * sizeof(T))", __FILE__, __LINE__);
     capacity_ = count;
   }
   void swap(DeviceBuffer& other) noexcept {

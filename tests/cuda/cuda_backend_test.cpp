@@ -986,5 +986,20 @@ TEST(CudaBackend, BadDeviceIsAnError) {
   EXPECT_THROW(cuda::make_cuda_backend(-1), snag::InternalError);
 }
 
+TEST(CudaBackend, ADeviceThatRunsTheBuildHasNoProblemAndAMissingOneIsNamed) {
+  SNAG_REQUIRE_GPU();
+  // The GPUs the tests run on are among the build's architectures (the device machine's H200
+  // and sm_90 by default): usable, so `--backend auto` takes them, and nothing to explain.
+  const int count = cuda::cuda_device_count();
+  for (int device = 0; device < count; ++device)
+    EXPECT_EQ(cuda::cuda_device_problem(device), "") << "device " << device;
+  EXPECT_EQ(cuda::cuda_runtime_problem(), "");
+  const std::string missing = cuda::cuda_device_problem(count);
+  EXPECT_NE(missing.find("no CUDA device " + std::to_string(count)), std::string::npos) << missing;
+  EXPECT_NE(cuda::cuda_device_problem(-1), "");
+  // The probe leaves no error pending for the next CUDA call to report as its own.
+  EXPECT_NO_THROW(cuda::make_cuda_backend(0));
+}
+
 }  // namespace
 }  // namespace snag::test

@@ -21,6 +21,17 @@ namespace snag::cuda {
 /// too old for this build. Never throws for that.
 int cuda_device_count();
 
+/// When cuda_device_count() is 0 on a machine that has an NVIDIA driver: why, in words (a
+/// driver older than this build's CUDA runtime, a GPU the driver cannot bring up, ...). Empty
+/// when there are devices, and on a machine with no driver or no GPU, where using the CPU is
+/// the ordinary case and needs no explanation.
+std::string cuda_runtime_problem();
+
+/// Why CUDA device `device` cannot run this build's kernels, or empty when it can: a GPU older
+/// than every architecture the build has code for (SNAG_CUDA_ARCHITECTURES), a device that
+/// another process holds in exclusive mode, or no such device. Never throws.
+std::string cuda_device_problem(int device);
+
 /// Device-side time of the last run of each stage, in milliseconds, from CUDA events recorded
 /// on the backend's stream around the stage's kernels and copies. Stages are queued without
 /// waiting where the interface allows: a checker's frame waits twice, at the end of the scan
