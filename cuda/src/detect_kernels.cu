@@ -501,6 +501,14 @@ __global__ void __launch_bounds__(kBlock)
 }
 
 /// Adds pair `key` to the set; the thread that inserts it classifies it and appends it.
+///
+/// The table has at least twice as many slots as the set's pair capacity, but a run may bring
+/// more distinct keys than that: the stored hits of non-manifold edges (three faces or more), the
+/// duplicated faces, hits beyond what the last frame's pairs were sized for. A key that finds
+/// the table full is dropped after one probe of every slot: every slot then holds a key whose
+/// thread counted it in counters->pairs, so the count exceeds the pair capacity and the host
+/// grows the buffers (the table to twice the expanded pairs and duplicates, which bound every
+/// key) and runs the frame again. Probing on, it waited for a slot that never empties.
 __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::Vec3d* positions,
                                             const geom::Tri* triangles, const PairSet& set,
                                             FrameCounters* counters) {
@@ -509,7 +517,8 @@ __device__ __forceinline__ void insert_pair(uint64_t key, int bits, const geom::
   // Loaded ahead of the probe, whose atomics they would otherwise wait behind.
   const geom::Tri ta = triangles[a], tb = triangles[b];
   unsigned long long slot = (key * 0x9E3779B97F4A7C15ull) >> 20 & set.table_mask;
-  for (;;) {
+  for (unsigned long long probes = 0;; ++probes) {
+    if (probes > set.table_mask) return;  // full: counted past the capacity (above)
     const unsigned long long was =
         atomicCAS(set.table + slot, kEmptyKey, static_cast<unsigned long long>(key));
     if (was == key) return;  // another thread has it

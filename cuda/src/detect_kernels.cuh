@@ -80,8 +80,9 @@ struct SubwalkList {
 /// The pairs of a frame as the expansion leaves them: distinct (a << bits | b) keys, a < b, in
 /// no particular order, each with its filtered kind (bit 0 = touching, bit 1 = certain), and
 /// the open-addressing set that made them distinct (empty slots hold kEmptyKey; cleared before
-/// every expansion). table_mask + 1 (a power of two) is at least twice pair_capacity, so a
-/// probe always ends.
+/// every expansion). table_mask + 1 (a power of two) is at least twice pair_capacity; a run
+/// that brings more keys than the table holds ends its probes after one pass over the table
+/// and is run again with larger buffers (insert_pair).
 struct PairSet {
   unsigned long long* table = nullptr;
   unsigned long long table_mask = 0;

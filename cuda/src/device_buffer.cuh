@@ -141,7 +141,10 @@ class EventTimer {
  public:
   EventTimer() {
     SNAG_CUDA_CHECK(cudaEventCreate(&start_));
-    SNAG_CUDA_CHECK(cudaEventCreate(&stop_));
+    if (const cudaError_t status = cudaEventCreate(&stop_); status != cudaSuccess) {
+      cudaEventDestroy(start_);  // no destructor runs for an object whose constructor threw
+      throw_cuda_error(status, "cudaEventCreate(&stop_)", __FILE__, __LINE__);
+    }
   }
   ~EventTimer() {
     cudaEventDestroy(start_);

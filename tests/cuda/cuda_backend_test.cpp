@@ -285,6 +285,32 @@ TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
   EXPECT_EQ(result.pairs, brute_force(stack));
 }
 
+TEST(CudaDetect, PairsBeyondThePairSetsTableGrowItInsteadOfFillingIt) {
+  SNAG_REQUIRE_GPU();
+  // The pair set's table has twice the slots of the pair buffer, sized from the last run; one
+  // run can bring more distinct pairs than that: a hit on an edge of three faces makes three, a
+  // duplicated face one more. With buffers of 1 and 7 entries (tables of 2 and 16 slots), a
+  // table that filled up left the expansion probing for a free slot forever.
+  SmallMesh mesh = folded_grid(30, 20);
+  const size_t faces = mesh.triangles.size();
+  for (size_t f = 0; f < faces; f += 10) mesh.triangles.push_back(mesh.triangles[f]);
+  for (size_t f = 5; f < faces; f += 40) {  // fins: a third face on an edge, through the fold
+    const geom::Tri face = mesh.triangles[f];
+    const geom::Vec3d mid = 0.5 * (mesh.positions[face.v[0]] + mesh.positions[face.v[1]]);
+    mesh.positions.push_back(mid + geom::Vec3d{0.5, 0.5, 3.0});
+    mesh.triangles.push_back(
+        {face.v[0], face.v[1], static_cast<int32_t>(mesh.positions.size() - 1)});
+  }
+  const detect::Topology topology =
+      detect::make_topology(mesh.triangles, static_cast<int32_t>(mesh.positions.size()));
+  auto cpu = detect::make_cpu_backend(2);
+  cpu->set_topology(topology);
+  const Filtered expected = filtered(*cpu, mesh.positions, true);
+  ASSERT_GT(expected.frame.pairs.size(), 100u);  // hits and duplicated faces beyond the tables
+  for (int64_t capacity : {1, 7})
+    expect_same_filtered(mesh, "capacity " + std::to_string(capacity), capacity);
+}
+
 TEST(CudaDetect, RefitMatchesRebuildTheCpuAndBruteForceAfterDeformation) {
   SNAG_REQUIRE_GPU();
   SmallMesh mesh = folded_grid(15, 10);

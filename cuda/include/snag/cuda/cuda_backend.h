@@ -110,8 +110,9 @@ class CudaBackend : public detect::Backend {
 /// profiling; CudaBackend::take_stream_trace).
 bool stream_trace_compiled();
 
-/// The CUDA backend on device `device` (0-based). Throws snag::UsageError when there is no such
-/// device, snag::InternalError when a CUDA call fails.
+/// The CUDA backend on device `device` (0-based). Throws snag::InternalError when there is no
+/// such device, when it cannot run this build's kernels (cuda_device_problem), or when a CUDA
+/// call fails.
 std::unique_ptr<detect::Backend> make_cuda_backend(int device = 0);
 
 }  // namespace snag::cuda
