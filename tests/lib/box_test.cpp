@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "snag/geom/box.h"
@@ -92,6 +93,26 @@ TEST(Box, TriangleBoxContainsItsCornersExactly) {
   EXPECT_EQ(box.lo[0], reference_down(-0.0));
   EXPECT_EQ(box.hi[2], std::numeric_limits<float>::infinity());
   EXPECT_EQ(box.lo[2], reference_down(-0.7));
+}
+
+TEST(Box, BoxesThatOnlyTouchOverlapOnEveryAxisInBothOrders) {
+  // Triangles that touch at a point or along an edge intersect (BRIEF.md), and their boxes
+  // may meet in a face and no more: overlap is closed on every side. One float further apart,
+  // they do not.
+  for (int axis = 0; axis < 3; ++axis)
+    for (float at : {0.0f, 1.0f, -2.5f, 1e-30f, 3e30f}) {
+      Box3f low{{-1e3f, -1e3f, -1e3f}, {1e3f, 1e3f, 1e3f}}, high = low;
+      low.hi[axis] = at;
+      low.lo[axis] = at - 1.0f;
+      high.lo[axis] = at;
+      high.hi[axis] = at + 1.0f;
+      SCOPED_TRACE("axis " + std::to_string(axis) + " at " + std::to_string(at));
+      EXPECT_TRUE(overlap(low, high));
+      EXPECT_TRUE(overlap(high, low));
+      high.lo[axis] = std::nextafter(at, std::numeric_limits<float>::infinity());
+      EXPECT_FALSE(overlap(low, high));
+      EXPECT_FALSE(overlap(high, low));
+    }
 }
 
 TEST(Box, AnEmptyBoxOverlapsNoBoxShortOfFltMaxHasNoAreaAndLeavesMergesAlone) {

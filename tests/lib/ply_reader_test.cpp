@@ -187,23 +187,32 @@ TEST_P(PlyEncodings, SkipsOtherPropertiesAndElements) {
 
 TEST_P(PlyEncodings, RejectsIndexOutOfRange) {
   const Enc enc = GetParam();
-  Body b(enc);
-  for (int i = 0; i < 3; ++i) b.put<float>(1.f * i).put<float>(0.f).put<float>(0.f).end();
-  b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).end();
-  b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(3).put<int32_t>(2).end();
-  const std::string h =
-      header(enc,
-             "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-             "element face 2\nproperty list uchar int vertex_indices\n");
-  const InputError e = reject(h + b.str());
-  expect_contains(e, "face 1 (of 2)");
-  expect_contains(e, "vertex 3");
-  expect_contains(e, "expected 0..2");
-  if (enc == Enc::ascii) {
-    EXPECT_EQ(e.line(), 15);  // the header's 10 lines, 3 vertices, face 0, then face 1
-  } else {
-    // The header, 3 vertices of 12 bytes, face 0 (13 bytes), face 1's count and first index.
-    EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(h.size() + 36 + 13 + 1 + 4));
+  // The first index past the vertices, in each corner in turn: the binary reader's fast path
+  // checks a triangle's corners one by one, and a bound off by one on any of them let the
+  // index through to the checker (exit status 4 instead of an input error).
+  for (int corner = 0; corner < 3; ++corner) {
+    Body b(enc);
+    for (int i = 0; i < 3; ++i) b.put<float>(1.f * i).put<float>(0.f).put<float>(0.f).end();
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).end();
+    b.put<uint8_t>(3);
+    for (int k = 0; k < 3; ++k) b.put<int32_t>(k == corner ? 3 : k);
+    b.end();
+    const std::string h =
+        header(enc,
+               "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 2\nproperty list uchar int vertex_indices\n");
+    SCOPED_TRACE("corner " + std::to_string(corner));
+    const InputError e = reject(h + b.str());
+    expect_contains(e, "face 1 (of 2)");
+    expect_contains(e, "vertex 3");
+    expect_contains(e, "expected 0..2");
+    if (enc == Enc::ascii) {
+      EXPECT_EQ(e.line(), 15);  // the header's 10 lines, 3 vertices, face 0, then face 1
+    } else {
+      // The header, 3 vertices of 12 bytes, face 0 (13 bytes), face 1's count and the indices
+      // before the bad one.
+      EXPECT_EQ(e.byte_offset(), static_cast<int64_t>(h.size() + 36 + 13 + 1 + 4 * corner));
+    }
   }
 }
 

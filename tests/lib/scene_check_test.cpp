@@ -73,6 +73,25 @@ TEST(SceneCheck, APartWithoutTrianglesChecksAsEmpty) {
   }
 }
 
+TEST(SceneCheck, PartsWhoseTreesOnlyTouchStillMeetInEitherOrder) {
+  // A cloth triangle and an obstacle triangle whose edges cross at one point, (4, 1, 0), where
+  // the cloth's box begins in x and the obstacle's ends: the test of the two trees' roots
+  // must count boxes that meet in a face as overlapping, whichever part comes first.
+  const SmallMesh cloth{{{4, 0, 0}, {8, 0, 0}, {4, 4, 0}}, {{{0, 1, 2}}}};
+  const SmallMesh obstacle{{{4, 1, -4}, {4, 1, 4}, {0, 1, 0}}, {{{0, 1, 2}}}};
+  for (const auto& parts : {std::vector<SmallMesh>{cloth, obstacle}, {obstacle, cloth}}) {
+    const Laid laid = lay_end_to_end(parts);
+    const std::vector<detect::PartCheck> checks = {{0, 1}};
+    ASSERT_EQ(expected_pairs(laid, checks).size(), 1u);  // touching, by brute force
+    for (int threads : {1, 2}) {
+      auto checker = make_checker(threads);
+      checker->set_scene(laid.mesh.triangles, static_cast<int32_t>(laid.mesh.positions.size()),
+                         laid.layout, checks);
+      EXPECT_EQ(checker->check(laid.mesh.positions).pairs, expected_pairs(laid, checks));
+    }
+  }
+}
+
 TEST(SceneCheck, OnePartSceneIsTheSingleMeshCheck) {
   const SmallMesh mesh = folded_grid(11, 7);
   auto scene = make_checker(2), single = make_checker(2);

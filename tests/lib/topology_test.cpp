@@ -136,6 +136,48 @@ TEST(Topology, EdgesOwnershipAndNeighbourPairsMatchBruteForce) {
   }
 }
 
+TEST(Topology, OwnershipWithoutAFramesDegenerateTrianglesMatchesBruteForce) {
+  // A frame's zero-area triangles own nothing: each edge goes to its smallest incident triangle
+  // that is not degenerate this frame, however many degenerate ones come before it. Few
+  // vertices, so that edges have many faces (and several degenerate ones each).
+  for (uint32_t seed = 1; seed <= 30; ++seed) {
+    const int32_t vertices = 6 + static_cast<int32_t>(seed % 5);
+    const std::vector<geom::Tri> triangles = random_mesh(vertices, 60, 0, 100 + seed);
+    const Topology topo = make_topology(triangles, vertices);
+    const auto n = static_cast<int32_t>(triangles.size());
+    std::mt19937 rng(seed);
+    for (int share : {10, 40, 70, 100}) {  // percent of the proper triangles made degenerate
+      std::vector<int32_t> degenerate;
+      for (int32_t t = 0; t < n; ++t)
+        if (!repeats_corner(triangles[t]) && static_cast<int>(rng() % 100) < share)
+          degenerate.push_back(t);
+      const std::vector<uint8_t> owned = ownership_without(topo, degenerate);
+      ASSERT_EQ(owned.size(), static_cast<size_t>(n));
+      const auto is_degenerate = [&](int32_t t) {
+        return repeats_corner(triangles[t]) ||
+               std::binary_search(degenerate.begin(), degenerate.end(), t);
+      };
+      for (int32_t t = 0; t < n; ++t) {
+        uint8_t expected = 0;
+        for (int k = 0; k < 3 && !is_degenerate(t); ++k) {
+          const int32_t a = triangles[t].v[k], b = triangles[t].v[(k + 1) % 3];
+          int32_t owner = -1;  // the smallest triangle on edge {a, b} that is not degenerate
+          for (int32_t f = 0; f < n && owner < 0; ++f)
+            for (int kk = 0; kk < 3; ++kk) {
+              const int32_t c = triangles[f].v[kk], d = triangles[f].v[(kk + 1) % 3];
+              if (!is_degenerate(f) && std::min(a, b) == std::min(c, d) &&
+                  std::max(a, b) == std::max(c, d))
+                owner = f;
+            }
+          if (owner == t) expected |= static_cast<uint8_t>(1u << k);
+        }
+        ASSERT_EQ(owned[t], expected)
+            << "seed " << seed << ", " << share << "% degenerate, triangle " << t;
+      }
+    }
+  }
+}
+
 TEST(Topology, EmptyAndAllDegenerateMeshes) {
   expect_matches_brute_force({}, 3);
   expect_matches_brute_force({geom::Tri{{0, 0, 1}}, geom::Tri{{2, 2, 2}}}, 3);

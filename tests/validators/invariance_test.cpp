@@ -309,6 +309,32 @@ struct Tally {
   int64_t decisions_certain = 0, decisions_uncertain = 0;
 };
 
+TEST(FilterSoundness, AWrongDoubleSignNearTheBoundIsLeftUncertain) {
+  // Found by searching for the largest error of a double orient3d (the random regimes below
+  // never passed 3 epsilon times the permanent): here the double determinant of orient3d(0, 1,
+  // 2, 3) is +1.1e-15, 3.64 epsilon times its permanent, and the exact sign is negative. A
+  // bound under that (3 epsilon, say) certified the wrong sign, and the two triangles below,
+  // which cross, were reported clean.
+  const geom::Vec3d p[kPoints] = {{0.3037069400197609, -0.6957322242387594, 1.1288350501703257},
+                                  {0.6405661201215284, -0.042324986335178734, -3.397043849801549},
+                                  {-0.20856658043368337, 0.09580041158322421, 0.5232964005473292},
+                                  {0.3263024978808428, -0.18331715297177215, -1.1402896442598311},
+                                  {0.7288173088891242, 0.15216646703981396, -1.2645175301103486},
+                                  {0.5887476172771886, 0.2789382181120243, -1.0540195381441002}};
+  const geom::FilteredPredicates filtered{p};
+  const validators::CgalPredicates exact{p};
+  ASSERT_EQ(exact.orient3d(0, 1, 2, 3), Sign::negative);
+  const geom::Vec3d u = p[1] - p[0], v = p[2] - p[0], w = p[3] - p[0];
+  const double naive =
+      u.x * (v.y * w.z - v.z * w.y) - u.y * (v.x * w.z - v.z * w.x) + u.z * (v.x * w.y - v.y * w.x);
+  ASSERT_GT(naive, 0.0);  // the rounded determinant has the wrong sign
+  EXPECT_EQ(filtered.orient3d(0, 1, 2, 3), Sign::uncertain);
+  EXPECT_EQ(filtered.plane(0, 1, 2).side(3), Sign::uncertain);
+  const geom::Tri a{{0, 1, 2}}, b{{3, 4, 5}};
+  EXPECT_EQ(geom::is_crossing(exact, a, b), geom::Answer::yes);
+  EXPECT_NE(geom::is_crossing(filtered, a, b), geom::Answer::no);
+}
+
 TEST(FilterSoundness, NeverCertifiesAWrongSignOnMillionsOfNearDegenerateInputs) {
   constexpr uint64_t kSeed = 4004;
   constexpr int64_t kSamplesPerRegime = 450000;  // 4.05 million point sets in all
