@@ -375,45 +375,107 @@ __global__ void __launch_bounds__(kNarrowBlock)
   lister.finish();
 }
 
-/// The subwalks of one check, one per handed-over (position, node): the leaf at `position` of
-/// `tree` (its triangle plus `base` is t) against the leaves under `node` of `walked` (the
-/// same tree for a part against itself), listing (t, leaf) for every overlap. Queued before
-/// the walks' count is known, on a grid for the count expected (SubwalkList::expected): one
-/// subwalk per thread, striding past that when there are more.
+/// The rounds of 32 leaves a subwalk warp takes at once (subwalk_kernel). On an H200, one and
+/// two each took the 36K frame from ~0.126 to ~0.117 ms in runs against the walked subwalks
+/// (two leases, so not told apart); four, in two's run, was slower at 36K and on n-body
+/// (0.123-0.132 and 0.259-0.274 ms against 0.116-0.117 and 0.243-0.245).
+inline constexpr int kSubwalkRounds = 2;
+
+/// The subwalks of one check: for each handed-over (position, node), the leaf at `position` of
+/// `tree` (its triangle plus `base` is t) against the leaves under `node` of `walked` (the same
+/// tree for a part against itself), listing (t, leaf) for every overlap. A warp takes 32
+/// handovers, one a lane, and tests their leaves flat, 32 leaf boxes a round, each lane a leaf of
+/// whichever handover it falls in: no walk, so no chain of dependent box tests. Walked one per
+/// thread, the longest subwalks (37 to 51 box tests at 36K) held the kernel, at a few warps per
+/// scheduler; flat, a 36K frame's ~100K handovers of 11 leaves on average take ~12 rounds a warp,
+/// every load of a round independent of the others. Queued before the walks' count is known,
+/// on a grid for the count expected (SubwalkList::expected), striding past that when there are
+/// more.
 __global__ void __launch_bounds__(kBlock)
     subwalk_kernel(bvh::TreeView tree, int32_t base, bvh::TreeView walked, NeighborDrop drop,
                    SubwalkList subwalks, CandidateList listed, FrameCounters* counters) {
   wait_for_previous_kernel();
+  __shared__ uint64_t stage[kBlock / 32][WarpLister::kStage];
+  constexpr unsigned kAll = 0xffffffffu;
   const auto first = static_cast<unsigned long long>(blockIdx.x) * blockDim.x + threadIdx.x;
   const auto stride = static_cast<unsigned long long>(gridDim.x) * blockDim.x;
   const unsigned long long count = counters->subwalks;
   if (first == 0) atomicMax(&counters->subwalks_most, count);
   const unsigned long long stored = min(count, subwalks.capacity);
-  KeyLister lister(listed.pairs, listed.capacity, &counters->listed);
+  const int lane = static_cast<int>(threadIdx.x & 31);
+  WarpLister lister(stage[threadIdx.x / 32], listed.pairs, listed.capacity, &counters->listed);
   unsigned long long dropped = 0;
-  for (unsigned long long i = first; i < stored; i += stride) {
-    const uint64_t walk = subwalks.walks[i];
-    const auto position = static_cast<int32_t>(walk >> 32);
-    const auto node = static_cast<int32_t>(walk & 0xffffffffu);
-    const int32_t t = base + tree.triangle_at[position];
-    const geom::Box3f box = tree.boxes[tree.shape.leaf_at(position)];
-    // The leaf's later neighbours left out: all of them when its three corners have clear
-    // fans this frame, else none (NeighborDrop).
+  // The same for every lane of a warp (blocks hold whole warps), so the warp stays in step.
+  for (unsigned long long warp_first = first - lane; warp_first < stored; warp_first += stride) {
+    const unsigned long long i = warp_first + lane;
+    int32_t t = 0, position = 0, begin = 0, past = 0;
+    geom::Box3f box = geom::empty_box();
     uint64_t mask = 0;
-    if (drop.later) {
-      const uint64_t later = drop.later[base + position];
-      mask = detect::corners_clear(drop.fan_clear, drop.triangles[t]) ? later : 0;
+    if (i < stored) {
+      const uint64_t walk = subwalks.walks[i];
+      position = static_cast<int32_t>(walk >> 32);
+      t = base + tree.triangle_at[position];
+      box = tree.boxes[tree.shape.leaf_at(position)];
+      // The leaf's later neighbours left out: all of them when its three corners have clear
+      // fans this frame, else none (NeighborDrop).
+      if (drop.later) {
+        const uint64_t later = drop.later[base + position];
+        mask = detect::corners_clear(drop.fan_clear, drop.triangles[t]) ? later : 0;
+      }
+      walked.shape.positions_under(static_cast<int32_t>(walk & 0xffffffffu), begin, past);
     }
-    bvh::for_each_overlapping_leaf_under(walked, node, box, [&](int32_t leaf) {
-      // Bit d of the mask: the leaf at position + 1 + d is a neighbour cleared by a fan.
-      const auto d = static_cast<uint32_t>(walked.shape.position_of(leaf) - position - 1);
-      if (d < 64 && (mask >> d & 1u))
-        ++dropped;
-      else
-        lister.add(pack(t, leaf));
-    });
+    // The warp's items: lane k's leaves are items [end_k - (past_k - begin_k), end_k), end_k
+    // being the inclusive sum of the leaf counts up to lane k (so never decreasing).
+    int32_t end = past - begin;
+    for (int offset = 1; offset < 32; offset <<= 1) {
+      const int32_t before = __shfl_up_sync(kAll, end, offset);
+      if (lane >= offset) end += before;
+    }
+    const int32_t total = __shfl_sync(kAll, end, 31);
+    // kSubwalkRounds rounds at once, so that their shuffles and loads overlap: a round alone is
+    // a short chain (the owner's search, its box, the leaf's box, the test) that nothing hides.
+    for (int32_t first_item = 0; first_item < total; first_item += 32 * kSubwalkRounds) {
+      int32_t item[kSubwalkRounds], owner[kSubwalkRounds];
+      for (int r = 0; r < kSubwalkRounds; ++r) {
+        item[r] = first_item + 32 * r + lane;
+        owner[r] = 0;
+      }
+      // Each item's handover: the first lane whose end is past it, found by halving.
+      for (int step = 16; step > 0; step >>= 1)
+        for (int r = 0; r < kSubwalkRounds; ++r)
+          if (__shfl_sync(kAll, end, owner[r] + step - 1) <= item[r]) owner[r] += step;
+      int32_t leaf[kSubwalkRounds], leaf_position[kSubwalkRounds];
+      geom::Box3f leaf_box[kSubwalkRounds];
+      for (int r = 0; r < kSubwalkRounds; ++r) {
+        const int32_t owner_end = __shfl_sync(kAll, end, owner[r]);
+        leaf_position[r] = __shfl_sync(kAll, past, owner[r]) - (owner_end - item[r]);
+        // Past the last item, the root's box is read (it exists: total > 0) and ignored.
+        leaf[r] = item[r] < total ? walked.shape.leaf_at(leaf_position[r]) : 0;
+        leaf_box[r] = walked.boxes[leaf[r]];
+      }
+      for (int r = 0; r < kSubwalkRounds; ++r) {
+        const int32_t owner_position = __shfl_sync(kAll, position, owner[r]);
+        const int32_t owner_t = __shfl_sync(kAll, t, owner[r]);
+        const uint64_t owner_mask = __shfl_sync(kAll, mask, owner[r]);
+        geom::Box3f owner_box;
+        for (int k = 0; k < 3; ++k) {
+          owner_box.lo[k] = __shfl_sync(kAll, box.lo[k], owner[r]);
+          owner_box.hi[k] = __shfl_sync(kAll, box.hi[k], owner[r]);
+        }
+        bool hit = false;
+        if (item[r] < total && geom::overlap(owner_box, leaf_box[r])) {
+          // Bit d of the mask: the leaf at position + 1 + d is a neighbour cleared by a fan.
+          const auto d = static_cast<uint32_t>(leaf_position[r] - owner_position - 1);
+          if (d < 64 && (owner_mask >> d & 1u))
+            ++dropped;
+          else
+            hit = true;
+        }
+        lister.offer(hit, pack(owner_t, leaf[r]));
+      }
+    }
   }
-  lister.finish();
+  lister.flush();
   add_warp_total(dropped, &counters->candidates);
 }
 

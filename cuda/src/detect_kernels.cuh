@@ -212,8 +212,9 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// are the topology's) walks the later leaves' subtrees down to that level, handing every
 /// overlapping node there to `subwalks` (for trees of up to 2,048 nodes at that level, a warp
 /// per node of the level hands over the same, its leaves' climbs and the later nodes of the
-/// level that overlap them: bvh::climb_under_split); then one thread per
-/// subwalk walks that node's subtree, listing every overlapping leaf into `listed`, counted in
+/// level that overlap them: bvh::climb_under_split); then the subwalks, a warp per 32 of them,
+/// test the leaves under each handed-over node flat (at most 64, all their boxes loaded side
+/// by side rather than walked) and list every overlapping leaf into `listed`, counted in
 /// results.counters->listed (which the caller zeroes first, with ->subwalks and ->screened).
 /// The longest walk of a folded region's leaf (267 box tests at 36K) was the walk kernel's
 /// time, at two warps per scheduler: split, it is two chains of at most ~60, the second over
@@ -226,8 +227,8 @@ void launch_planes(const geom::Vec3d* positions, const geom::Tri* triangles, int
 /// that tested its pairs, or loaded anything at its leaves, held its warp's other walks back
 /// each time), and spreads the tests of a folded region's leaves over the whole device. With
 /// FilterUse::defer_all every test goes to the uncertain buffer (`--exact all`), in one pair
-/// test kernel of its own: it computes no sides to screen with. The subwalks run one per
-/// thread; the screen on one wave of its blocks (at most `max_blocks`) striding over the list,
+/// test kernel of its own: it computes no sides to screen with. The subwalks run a lane per
+/// handover; the screen on one wave of its blocks (at most `max_blocks`) striding over the list,
 /// and the whole test on a grid for the pairs expected (CandidateList::screened_expected, at
 /// most `max_blocks` blocks) striding over the pairs kept. `fans`: the part's fans, computed
 /// beside the walks (FanJob); `drop`: the fan-cleared neighbours the subwalks leave out
