@@ -377,7 +377,9 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
   if (inputs.empty()) throw UsageError("snag bench accuracy: no inputs");
 
   std::vector<std::string> backends = {"cpu"};
-  const bool with_cuda = resolve_auto_backend(0, nullptr) == "cuda";
+  std::string passed_over;
+  const bool with_cuda = resolve_auto_backend(o.device, &passed_over) == "cuda";
+  if (!passed_over.empty()) std::fprintf(stderr, "snag: warning: %s\n", passed_over.c_str());
   if (with_cuda) backends.push_back("cuda");
   std::vector<Method> methods;
   for (const std::string& backend : backends)

@@ -614,7 +614,9 @@ int run_bench_io(const BenchIoOptions& o) {
   cycled_copies(obj, o.frames, sequence_dir);
   const std::vector<seq::Frame> frames = seq::resolve_sequence(sequence_dir.string());
   std::vector<std::string> backends = {"cpu"};
-  if (resolve_auto_backend(o.device, nullptr) == "cuda") backends.push_back("cuda");
+  std::string passed_over;
+  if (resolve_auto_backend(o.device, &passed_over) == "cuda") backends.push_back("cuda");
+  if (!passed_over.empty()) std::fprintf(stderr, "snag: warning: %s\n", passed_over.c_str());
   sequence_table(cloth + " OBJ", frames, backends, threads, o.device, scratch.path() / "out");
   // Each --input of two frames or more, as it is: a studio's own cache, whose pairs (a clean
   // cache has few) decide what the reports cost.

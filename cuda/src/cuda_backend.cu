@@ -271,7 +271,12 @@ class CudaBackendImpl final : public CudaBackend {
     staged_copy_pending_ = true;
     staged_data_ = next.data();
     staged_size_ = next.size();
-    staged_moved_.assign(moved.begin(), moved.end());
+    // A list of another length says every part moved, as next_versions() reads it: stored
+    // empty, so that the work queued ahead (queue_ahead) reads it the same way.
+    if (moved.size() == part_.size())
+      staged_moved_.assign(moved.begin(), moved.end());
+    else
+      staged_moved_.clear();
     staged_version_ = versions;
   }
 

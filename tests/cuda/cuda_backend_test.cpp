@@ -285,7 +285,7 @@ TEST(CudaDetect, MoreResultsThanTheBuffersHoldAreAllFound) {
   EXPECT_EQ(result.pairs, brute_force(stack));
 }
 
-TEST(CudaDetect, PairsBeyondThePairSetsTableGrowItInsteadOfFillingIt) {
+TEST(CudaDetect, DuplicatedFacesAndNonManifoldEdgesFromTinyBuffersMatchTheCpu) {
   SNAG_REQUIRE_GPU();
   // The pair set's table has twice the slots of the pair buffer, sized from the last run; one
   // run can bring more distinct pairs than that: a hit on an edge of three faces makes three, a

@@ -2,6 +2,7 @@
 // nextafterf: float_down(x) is the largest float not above x, float_up(x) the smallest not below.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -101,11 +102,12 @@ TEST(Box, BoxesThatOnlyTouchOverlapOnEveryAxisInBothOrders) {
   // they do not.
   for (int axis = 0; axis < 3; ++axis)
     for (float at : {0.0f, 1.0f, -2.5f, 1e-30f, 3e30f}) {
+      const float span = std::max(1.0f, std::fabs(at));  // boxes as wide as where they meet
       Box3f low{{-1e3f, -1e3f, -1e3f}, {1e3f, 1e3f, 1e3f}}, high = low;
       low.hi[axis] = at;
-      low.lo[axis] = at - 1.0f;
+      low.lo[axis] = at - span;
       high.lo[axis] = at;
-      high.hi[axis] = at + 1.0f;
+      high.hi[axis] = at + span;
       SCOPED_TRACE("axis " + std::to_string(axis) + " at " + std::to_string(at));
       EXPECT_TRUE(overlap(low, high));
       EXPECT_TRUE(overlap(high, low));

@@ -311,8 +311,9 @@ struct Tally {
 
 TEST(FilterSoundness, AWrongDoubleSignNearTheBoundIsLeftUncertain) {
   // Found by searching for the largest error of a double orient3d (the random regimes below
-  // never passed 3 epsilon times the permanent): here the double determinant of orient3d(0, 1,
-  // 2, 3) is +1.1e-15, 3.64 epsilon times its permanent, and the exact sign is negative. A
+  // never passed 3 epsilon times the permanent): here the double determinants of orient3d(0,
+  // 1, 2, 3) are positive (the filter's +1.1e-15, 3.64 epsilon times its permanent; the plain
+  // cofactor expansion below +6.7e-16) and the exact sign is negative (-1.2e-17). A
   // bound under that (3 epsilon, say) certified the wrong sign, and the two triangles below,
   // which cross, were reported clean.
   const geom::Vec3d p[kPoints] = {{0.3037069400197609, -0.6957322242387594, 1.1288350501703257},

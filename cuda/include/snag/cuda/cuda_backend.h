@@ -29,7 +29,8 @@ std::string cuda_runtime_problem();
 
 /// Why CUDA device `device` cannot run this build's kernels, or empty when it can: a GPU older
 /// than every architecture the build has code for (SNAG_CUDA_ARCHITECTURES), a device that
-/// another process holds in exclusive mode, or no such device. Never throws.
+/// another process holds in exclusive mode, or no such device. Never throws. Makes `device`
+/// the calling thread's current device and creates its context (as the backend would).
 std::string cuda_device_problem(int device);
 
 /// Device-side time of the last run of each stage, in milliseconds, from CUDA events recorded
