@@ -203,6 +203,7 @@ class CudaBackendImpl final : public CudaBackend {
     if (static_cast<int64_t>(positions.size()) != topo_.vertex_count)
       throw InternalError("cuda backend: " + std::to_string(positions.size()) + " positions for " +
                           std::to_string(topo_.vertex_count) + " vertices");
+    moved = moved_per_part(moved);
     const int slot = 1 - positions_slot_;
     scanned_ = false;
     if (staged_ && positions.data() == staged_data_ && positions.size() == staged_size_ &&
@@ -256,6 +257,7 @@ class CudaBackendImpl final : public CudaBackend {
     }
     require_topology();
     if (static_cast<int64_t>(next.size()) != topo_.vertex_count) return;  // not a next frame
+    moved = moved_per_part(moved);
     drop_staged_positions();
     const std::vector<uint64_t> versions = next_versions(moved);
     if (slot_version_[positions_slot_] == versions) return;  // the next frame is this one
@@ -271,12 +273,7 @@ class CudaBackendImpl final : public CudaBackend {
     staged_copy_pending_ = true;
     staged_data_ = next.data();
     staged_size_ = next.size();
-    // A list of another length says every part moved, as next_versions() reads it: stored
-    // empty, so that the work queued ahead (queue_ahead) reads it the same way.
-    if (moved.size() == part_.size())
-      staged_moved_.assign(moved.begin(), moved.end());
-    else
-      staged_moved_.clear();
+    staged_moved_.assign(moved.begin(), moved.end());
     staged_version_ = versions;
   }
 
@@ -470,22 +467,24 @@ class CudaBackendImpl final : public CudaBackend {
   };
   FrameView current_view() const { return {current_positions_, part_versions()}; }
 
-  /// The versions of a frame whose parts moved as `moved` says (empty, or a list of another
-  /// length: all of them).
+  /// `moved` as the rest of the backend reads it: empty (every part moved) unless it has an
+  /// entry per part. A caller's list of another length (a next frame whose parts split or
+  /// merged) was read past its end.
+  std::span<const uint8_t> moved_per_part(std::span<const uint8_t> moved) const {
+    return moved.size() == part_.size() ? moved : std::span<const uint8_t>{};
+  }
+  /// The versions of a frame whose parts moved as `moved` says (empty: all of them).
   std::vector<uint64_t> next_versions(std::span<const uint8_t> moved) {
-    const bool all = moved.size() != part_.size();
     std::vector<uint64_t> versions(part_.size());
     for (size_t p = 0; p < part_.size(); ++p)
-      versions[p] = all || moved[p] || part_[p].version == 0 ? ++versions_issued_
-                                                             : part_[p].version;
+      versions[p] = moved.empty() || moved[p] || part_[p].version == 0 ? ++versions_issued_
+                                                                       : part_[p].version;
     return versions;
   }
-  /// Whether two `moved` lists say the same of every part (an empty one, or one of another
-  /// length: every part moved).
+  /// Whether two `moved` lists say the same of every part (an empty one: every part moved).
   bool same_moved(std::span<const uint8_t> a, const std::vector<uint8_t>& b) const {
-    const bool all_a = a.size() != part_.size(), all_b = b.size() != part_.size();
     for (size_t p = 0; p < part_.size(); ++p) {
-      const bool in_a = all_a || a[p], in_b = all_b || b[p];
+      const bool in_a = a.empty() || a[p], in_b = b.empty() || b[p];
       if (in_a != in_b) return false;
     }
     return true;

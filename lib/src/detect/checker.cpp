@@ -132,14 +132,8 @@ FrameResult Checker::check(const FrameInput& input) {
   }
   const ExactContext context{positions, topology_.get(), settings_.threads};
   backend_->set_part_positions(positions, moved);
-  // The next frame is a hint: one of another size (a topology change ahead) is not staged, and
-  // a `next_moved` of another layout (parts that split or merged) is read as every part moved.
-  if (!input.next_positions.empty() &&
-      static_cast<int64_t>(input.next_positions.size()) == topology_->vertex_count) {
-    const bool layout_kept = static_cast<int32_t>(input.next_moved.size()) == part_count;
-    backend_->stage_part_positions(input.next_positions,
-                                   layout_kept ? input.next_moved : std::span<const uint8_t>{});
-  }
+  if (!input.next_positions.empty())
+    backend_->stage_part_positions(input.next_positions, input.next_moved);
 
   // Zero-area triangles first: they are left out of the search and own no edges. Mode `all`
   // decides every triangle exactly. Parts that did not move keep their last frame's.

@@ -85,8 +85,10 @@ class Backend {
   /// same span (same address and size, contents unchanged since) then copies nothing. The span
   /// must stay valid and unchanged until the next set_part_positions() (the GPU backend reads
   /// it while the current frame's work runs); a different span then drops it unread. A hint:
-  /// the CPU backend has nothing to copy, and a span never set is dropped. `moved` as in
-  /// set_part_positions, relative to the frame being checked. An empty `next` forgets a frame
+  /// the CPU backend has nothing to copy, and a span never set is dropped; so is a `next` of
+  /// another vertex count. `moved` as in set_part_positions, relative to the frame being
+  /// checked; one of another length than the parts (the next frame's layout differs) counts as
+  /// every part moved. An empty `next` forgets a frame
   /// staged before (a caller whose run stopped between staging a frame and setting it, and whose
   /// span may since hold something else).
   virtual void stage_part_positions(std::span<const geom::Vec3d> next,
