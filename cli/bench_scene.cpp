@@ -499,7 +499,7 @@ CLI::App* add_bench_scene_command(CLI::App& bench, BenchSceneOptions& o) {
       ->capture_default_str();
   cmd->add_option("--backend", o.backend,
                   "cpu, cuda, or both (the CPU, and the GPU where snag has the CUDA backend and "
-                  "a device)")
+                  "a device that can run it; else the GPU's row says why it was skipped)")
       ->type_name("NAME")
       ->check(CLI::IsMember({"cpu", "cuda", "both"}))
       ->capture_default_str();
