@@ -182,6 +182,9 @@ int main(int argc, char** argv) {
   } catch (const snag::cli::DeviceUnavailable& e) {
     std::cerr << "snag: error: " << e.what() << "\n";
     return 4;
+  } catch (const snag::OutOfDeviceMemory& e) {
+    std::cerr << "snag: error: " << e.what() << "; check it with --backend cpu\n";
+    return 4;
   } catch (const snag::InternalError& e) {
     std::cerr << "snag: internal error: " << e.what() << "\n";
     return 4;

@@ -19,7 +19,7 @@ namespace snag::cuda {
 
 /// A device allocation that did not fit: how much was asked for and how much is free, in
 /// words a user can act on (a frame with millions of candidate pairs, on a GPU that is small or
-/// shared with another job).
+/// shared with another job). The command line adds what to do.
 [[noreturn]] inline void throw_out_of_device_memory(size_t bytes) {
   size_t free = 0, total = 0;
   if (cudaMemGetInfo(&free, &total) != cudaSuccess) cudaGetLastError();
@@ -30,8 +30,8 @@ namespace snag::cuda {
   message += mib(free);
   message += " of ";
   message += mib(total);
-  message += " free); check it with --backend cpu";
-  throw InternalError(message);
+  message += " free)";
+  throw OutOfDeviceMemory(message);
 }
 
 }  // namespace snag::cuda
