@@ -345,8 +345,9 @@ int run_check(const CheckOptions& o) {
   const auto fail_on = report::parse_fail_on(o.fail_on);
   if (!fail_on)
     throw UsageError("--fail-on: expected crossing, any or none, got '" + o.fail_on + "'");
+  // The command line's validators (commands.h) reject these already, NaN included; checked
+  // again, NaN-proof, for callers that fill CheckOptions themselves.
   if (o.weld && !(*o.weld >= 0)) throw UsageError("--weld: TOL must be a number >= 0");
-  // CLI11's range check lets NaN through (every comparison with it is false).
   if (!(o.rebuild_threshold >= 1))
     throw UsageError("--rebuild-threshold: FACTOR must be a number >= 1");
   const auto exact = detect::parse_exact_mode(o.exact);

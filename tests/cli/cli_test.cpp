@@ -296,6 +296,9 @@ TEST(CliCheck, KilledRunLeavesNoTemporaries) {
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
+      // snag keeps a signal its caller ignores ignored (AnIgnoredInterruptStaysIgnored); a test
+      // runner started in the background or under nohup passes SIGINT on ignored.
+      ::signal(signal_number, SIG_DFL);
       if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
       ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
               "--fail-on", "none", "--out", out.c_str(), static_cast<char*>(nullptr));
@@ -328,6 +331,137 @@ TEST(CliCheck, KilledRunLeavesNoTemporaries) {
         << "signal " << signal_number << ", status " << status;
     EXPECT_EQ(temporaries(), "") << "signal " << signal_number;
   }
+}
+
+// The hand-built sequence's topology changes at frame 2: the progress line says so, and the
+// summary counts builds, rebuilds and topology changes in words that agree in number; under
+// --rebuild always every frame is rebuilt (frames.csv's `rebuilt`), where auto leaves frame 3's
+// refit tree alone.
+TEST(CliCheck, ProgressAndSummaryCountTopologyChangesAndRebuilds) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult never = run_snag({"check", "seq", "--rebuild", "never"}, tmp.path());
+  EXPECT_NE(never.err.find("[2/3] frame 2: 1 crossing, 0 touching (topology changed)\n"),
+            std::string::npos)
+      << never.err;
+  EXPECT_NE(never.out.find("tree                 2 builds, 0 rebuilds (--rebuild never), "
+                           "1 topology change\n"),
+            std::string::npos)
+      << never.out;
+  const RunResult always =
+      run_snag({"check", "seq", "--rebuild", "always", "--out", "a"}, tmp.path());
+  EXPECT_NE(always.out.find("tree                 3 builds, 1 rebuild (--rebuild always)"),
+            std::string::npos)
+      << always.out;
+  EXPECT_EQ(without_column(read_text(tmp.path() / "a" / "frames.csv"), "seconds"),
+            "frame,file,triangles,pairs,crossing,touching,degenerate,uncertain,rebuilt,"
+            "topology_changed\n"
+            "1,seq/f.0001.obj,3,1,1,0,0,0,1,0\n"
+            "2,seq/f.0002.obj,3,1,1,0,0,0,1,1\n"
+            "3,seq/f.0003.obj,3,0,0,0,0,0,1,0\n");
+}
+
+// report.json's settings are what ran: --threads 0 resolved to every core (OpenMP's count,
+// here OMP_NUM_THREADS), the --frames selection as given, or null without one.
+TEST(CliCheck, ReportSettingsGiveTheThreadsAndFramesThatRan) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  ASSERT_EQ(::setenv("OMP_NUM_THREADS", "3", 1), 0);
+  const RunResult zero =
+      run_snag({"check", "seq", "--frames", "1-3x2", "--threads", "0", "--out", "z"}, tmp.path());
+  ::unsetenv("OMP_NUM_THREADS");
+  ASSERT_EQ(zero.status, 1) << context(zero);
+  const auto z = nlohmann::json::parse(read_text(tmp.path() / "z" / "report.json"));
+  EXPECT_EQ(z.at("settings").at("threads"), 3) << "--threads 0: every core (OMP_NUM_THREADS)";
+  EXPECT_EQ(z.at("settings").at("frames"), "1-3x2");
+  EXPECT_EQ(z.at("summary").at("frames_checked"), 2);
+  run_snag({"check", "seq", "--out", "a"}, tmp.path());
+  const auto a = nlohmann::json::parse(read_text(tmp.path() / "a" / "report.json"));
+  EXPECT_TRUE(a.at("settings").at("frames").is_null());
+}
+
+// A sequence numbered on a grid of 2 that skips a number: the warning gives the step it counts
+// by, so that "skips 6" is not read as a sequence of every number.
+TEST(CliCheck, AGapWarningSaysTheStepItCountsBy) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const fs::path even = tmp.path() / "even";
+  fs::create_directories(even);
+  for (int f : {2, 4, 8})
+    fs::copy_file(tmp.path() / "seq" / "f.0003.obj", even / ("f.000" + std::to_string(f) + ".obj"));
+  const RunResult gap = run_snag({"check", "even"}, tmp.path());
+  EXPECT_NE(gap.err.find("the sequence skips frame numbers 6 (between its first frame, 2, and "
+                         "its last, 8, counting by 2)"),
+            std::string::npos)
+      << gap.err;
+}
+
+// A topology change re-welds, but the first frame's coincident-vertex warning (and count) is
+// said once; a later topology without triangles is warned of like a first frame without any.
+TEST(CliCheck, LaterTopologiesWarnOfEmptyFramesButNotAgainOfSeams) {
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "seq");
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 1 1 0\nv 0 1 0\nv 0 0 0\n";
+  write_text(tmp.path() / "seq" / "f.0001.obj", v + "f 1 2 3\nf 4 5 6\n");
+  write_text(tmp.path() / "seq" / "f.0002.obj", v + "f 4 5 6\nf 1 2 3\n");  // reordered
+  write_text(tmp.path() / "seq" / "f.0003.obj", v);                         // no faces
+  const RunResult r = run_snag({"check", "seq", "--fail-on", "none", "--out", "o"}, tmp.path());
+  EXPECT_EQ(r.status, 0) << context(r);
+  size_t warnings = 0;
+  for (size_t at = r.err.find("coincide"); at != std::string::npos;
+       at = r.err.find("coincide", at + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 1u) << r.err;
+  EXPECT_NE(r.err.find("seq/f.0003.obj: no triangles (6 vertices)"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(read_text(tmp.path() / "o" / "report.json"));
+  EXPECT_EQ(j.at("inputs").at("coincident_vertices"), 2);
+}
+
+// A caller that ignores SIGINT (nohup, a background job) keeps it ignored: the run goes on (it
+// is ended here by SIGTERM, or ends by itself), never by the interrupt.
+TEST(CliCheck, AnIgnoredInterruptStaysIgnored) {
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "seq");
+  const fs::path drape = source_dir() / "samples" / "drape";
+  for (int f = 1; f <= 3000; ++f) {
+    char name[32], sample[32];
+    std::snprintf(name, sizeof name, "f.%04d.obj", f);
+    std::snprintf(sample, sizeof sample, "drape.%04d.obj", (f - 1) % 12 + 1);
+    fs::create_symlink(drape / sample, tmp.path() / "seq" / name);
+  }
+  const std::string executable = snag_executable().string();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::signal(SIGINT, SIG_IGN);
+    if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
+    ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
+            "--fail-on", "none", "--out", "out", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Once the run is under way (its report temporaries are there), interrupt it.
+  const auto started = [&] {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(tmp.path() / "out", ec))
+      if (entry.path().filename().string().find(".tmp-") != std::string::npos) return true;
+    return false;
+  };
+  int status = 0;
+  pid_t ended = 0;
+  for (int wait = 0; wait < 30000 && ended == 0 && !started(); ++wait) {
+    ended = ::waitpid(child, &status, WNOHANG);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(ended, 0) << "the run ended before it was under way, status " << status;
+  ::kill(child, SIGINT);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ended = ::waitpid(child, &status, WNOHANG);
+  if (ended == 0) {
+    ::kill(child, SIGTERM);
+    ::waitpid(child, &status, 0);
+  }
+  EXPECT_FALSE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT)
+      << "an ignored SIGINT ended the run";
 }
 
 TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {

@@ -607,6 +607,22 @@ TEST(ReportWrite, UnwritableDirectoryLeavesNothing) {
   EXPECT_TRUE(entries(out).empty());
 }
 
+// The same for root, whom permissions do not stop: /proc/self/fdinfo (Linux) is a directory
+// in which nobody can create a file.
+TEST(ReportWrite, ADirectoryThatTakesNoFilesIsAWriteErrorEvenForRoot) {
+  const fs::path out = "/proc/self/fdinfo";
+  if (!fs::is_directory(out)) GTEST_SKIP() << "no /proc/self/fdinfo here (not Linux)";
+  try {
+    prepare_output_dir(out);
+    FAIL() << "prepare_output_dir accepted " << out;
+  } catch (const WriteError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot write into the output directory"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(write_reports(out, hand_built_report()), WriteError);
+}
+
 TEST(ReportWrite, FailureInALaterFileLeavesNoFileAndKeepsTheOldOnes) {
   // Works as root too: the failure comes from the writer, after earlier files were written
   // to their temporaries.

@@ -175,6 +175,13 @@ TEST_F(SequenceDir, NothingMatchedNamesThePattern) {
   EXPECT_THROW(resolve_sequence((dir_ / "missing_dir" / "f.%04d.obj").string()), InputError);
 }
 
+// The same with only two files: one numbered frame and one without digits.
+TEST_F(SequenceDir, AFileWithoutDigitsBesideOneFrameIsAnError) {
+  touch({"a.0001.obj", "rest.obj"});
+  EXPECT_THROW(resolve_sequence(dir_.string()), InputError);
+  EXPECT_THROW(resolve_sequence(at("*.obj")), InputError);
+}
+
 // A rest pose or a stray export beside a cache would be frame 0, checked first, and set the
 // topology of every frame after it.
 TEST_F(SequenceDir, AFileWithoutDigitsAmongFramesIsAnError) {
