@@ -19,6 +19,14 @@ bool cuda_built() {
 #endif
 }
 
+std::string cuda_build_line() {
+#ifdef SNAG_HAVE_CUDA
+  return "CUDA backend: " + cuda::cuda_build_description();
+#else
+  return "CUDA backend: not built (no CUDA compiler was found when this snag was built)";
+#endif
+}
+
 int cuda_devices() {
 #ifdef SNAG_HAVE_CUDA
   return cuda::cuda_device_count();

@@ -23,6 +23,11 @@ class DeviceUnavailable : public InternalError {
 /// Whether this snag was built with the CUDA backend.
 bool cuda_built();
 
+/// `snag --version`'s line about the GPU: the CUDA backend's architectures and runtime, or
+/// that this snag was built without it. Touches no device (a version query stays instant, and
+/// says what was built, not what this machine has).
+std::string cuda_build_line();
+
 /// Number of usable CUDA devices (0 without the CUDA backend, a driver or a GPU).
 int cuda_devices();
 

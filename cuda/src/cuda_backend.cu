@@ -1230,6 +1230,11 @@ std::string cuda_runtime_problem() {
   return "the CUDA runtime found no usable device: " + runtime_error_text(status);
 }
 
+std::string cuda_build_description() {
+  return std::string("architectures ") + SNAG_CUDA_ARCHITECTURES_TEXT + "; CUDA runtime " +
+         cuda_version_text(CUDART_VERSION) + ", linked statically";
+}
+
 std::string cuda_device_problem(int device) {
   const int count = cuda_device_count();
   if (device < 0 || device >= count)

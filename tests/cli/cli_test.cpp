@@ -622,6 +622,21 @@ TEST(CliStatus, HelpAndVersionExitZero) {
   }
 }
 
+// --version names the build's CUDA backend (or its absence) on a second line, so that a bug
+// report says what was built.
+TEST(CliStatus, VersionSaysWhatTheCudaBackendWasBuiltFor) {
+  TempDir tmp;
+  const RunResult r = run_snag({"--version"}, tmp.path());
+  ASSERT_EQ(r.status, 0) << context(r);
+  EXPECT_EQ(r.out.rfind("snag ", 0), 0u) << r.out;
+  const size_t line = r.out.find("\nCUDA backend: ");
+  ASSERT_NE(line, std::string::npos) << r.out;
+  const std::string rest = r.out.substr(line);
+  EXPECT_TRUE(rest.find("architectures ") != std::string::npos ||
+              rest.find("not built") != std::string::npos)
+      << r.out;
+}
+
 TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");

@@ -27,6 +27,11 @@ int cuda_device_count();
 /// the ordinary case and needs no explanation.
 std::string cuda_runtime_problem();
 
+/// What this build's CUDA backend was compiled for, in words: its architectures
+/// (SNAG_CUDA_ARCHITECTURES as CMake gave them to nvcc) and the CUDA runtime it links. Touches
+/// no device.
+std::string cuda_build_description();
+
 /// Why CUDA device `device` cannot run this build's kernels, or empty when it can: a GPU older
 /// than every architecture the build has code for (SNAG_CUDA_ARCHITECTURES), a device that
 /// another process holds in exclusive mode, or no such device. Never throws. Makes `device`
