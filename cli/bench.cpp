@@ -188,8 +188,7 @@ int run_bench_cpu(const BenchOptions& o) {
 
   std::vector<Row> rows;
   for (const BenchCase& c : cases) rows.push_back(run_case(c, o));
-  print_table(rows, thread_count(o.threads),
-              detect::cpu_walk_lanes(walk_width(o.walk_lanes)));
+  print_table(rows, thread_count(o.threads), detect::cpu_walk_lanes(walk_width(o.walk_lanes)));
   const bool all_same = std::all_of(rows.begin(), rows.end(), [](const Row& r) { return r.same; });
   if (!all_same) throw InternalError("snag and CGAL found different pairs (see the table)");
   return 0;

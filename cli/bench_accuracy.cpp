@@ -97,8 +97,8 @@ Method cgal_method() {
   return {"CGAL self_intersections", [](const mesh::Mesh& first) {
             std::shared_ptr<validators::CgalSequence> sequence;
             try {
-              sequence = std::make_shared<validators::CgalSequence>(first.positions,
-                                                                    first.triangles);
+              sequence =
+                  std::make_shared<validators::CgalSequence>(first.positions, first.triangles);
             } catch (const InternalError&) {
               // Not a halfedge mesh (a soup, non-manifold edges): CGAL's rules pair by pair.
             }
@@ -125,7 +125,8 @@ Method naive_method(int threads) {
             return [threads](const mesh::Mesh& m) {
               const auto n = static_cast<int32_t>(m.triangles.size());
               std::vector<uint8_t> flat(static_cast<size_t>(n));
-              for (int32_t t = 0; t < n; ++t) flat[t] = naive::degenerate(m.positions, m.triangles[t]);
+              for (int32_t t = 0; t < n; ++t)
+                flat[t] = naive::degenerate(m.positions, m.triangles[t]);
               bvh::Tree tree;
               tree.build({m.positions.data(), m.triangles.data(),
                           static_cast<int32_t>(m.positions.size()), n},
@@ -209,7 +210,8 @@ Input hard_corpus(const fs::path& dir) {
   for (const auto& [path, weld] : files) {
     mesh::Mesh m = io::read_mesh(path);
     if (weld)
-      m.triangles = mesh::welded_triangles(m.triangles, mesh::weld_representatives(m.positions, *weld));
+      m.triangles =
+          mesh::welded_triangles(m.triangles, mesh::weld_representatives(m.positions, *weld));
     input.frames.push_back(std::move(m));
   }
   if (input.frames.empty())
@@ -268,15 +270,16 @@ std::string kinds_cell(const Score& s) {
   return s.has_kinds ? std::to_string(s.wrong_kind) : "n/a";
 }
 
-void write_tables(const std::vector<Score>& scores, const fs::path& dir, const std::string& header) {
+void write_tables(const std::vector<Score>& scores, const fs::path& dir,
+                  const std::string& header) {
   std::ostringstream csv;
   csv << "input,triangles,frames,method,ms_per_frame,pairs,false_positives,false_negatives,"
          "wrong_kinds,unproven_decisions\n";
   for (const Score& s : scores)
     csv << report::csv_field(s.input) << ',' << s.triangles << ',' << s.frames << ','
         << report::csv_field(s.method) << ',' << s.seconds * 1e3 << ',' << s.pairs << ','
-        << s.false_positive << ',' << s.false_negative << ',' << kinds_cell(s) << ','
-        << s.unproven << '\n';
+        << s.false_positive << ',' << s.false_negative << ',' << kinds_cell(s) << ',' << s.unproven
+        << '\n';
   std::ostringstream md;
   md << header << "\n\n| input | triangles | method | ms/frame | pairs | false + | false - "
      << "| wrong kind | unproven |\n|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
@@ -288,9 +291,9 @@ void write_tables(const std::vector<Score>& scores, const fs::path& dir, const s
        << kinds_cell(s) << " | " << s.unproven << " |\n";
   }
   const std::string csv_text = csv.str(), md_text = md.str();
-  report::write_files_atomically(
-      dir, {{"accuracy.csv", [&](std::ostream& out) { out << csv_text; }},
-            {"accuracy.md", [&](std::ostream& out) { out << md_text; }}});
+  report::write_files_atomically(dir,
+                                 {{"accuracy.csv", [&](std::ostream& out) { out << csv_text; }},
+                                  {"accuracy.md", [&](std::ostream& out) { out << md_text; }}});
 }
 
 }  // namespace
@@ -310,9 +313,10 @@ CLI::App* add_bench_accuracy_command(CLI::App& bench, BenchAccuracyOptions& o) {
       ->type_name("N")
       ->check(kCount)
       ->capture_default_str();
-  cmd->add_option("--hard", o.hard_dir,
-                  "The hard-case corpus (default: samples/hard of $SNAG_SOURCE_DIR, else of the source tree "
-                  "known at build time)")
+  cmd->add_option(
+         "--hard", o.hard_dir,
+         "The hard-case corpus (default: samples/hard of $SNAG_SOURCE_DIR, else of the source tree "
+         "known at build time)")
       ->type_name("DIR");
   cmd->add_option("--device", o.device, "CUDA device, numbered from 0")
       ->type_name("N")
@@ -353,8 +357,7 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
   // Each case of the data folder that is there (a partial copy of it is still a corpus); a
   // --data folder that holds none of them is a usage error, as a mistyped path.
   std::vector<BenchCase> data_cases;
-  for (const auto& [name, folder] :
-       std::vector<std::pair<std::string, std::string>>{
+  for (const auto& [name, folder] : std::vector<std::pair<std::string, std::string>>{
            {"cloth-ball", "scalable-ccd/cloth-ball"},
            {"cloth-funnel", "scalable-ccd/cloth-funnel"},
            {"n-body", "scalable-ccd/n-body-simulation"},
@@ -363,7 +366,8 @@ int run_bench_accuracy(const BenchAccuracyOptions& o) {
            {"thick-cloth", "ipc-toolkit/thick-cloth"}})
     add_data_case(data_cases, data, "", name, folder, command);
   if (!data.empty() && fs::is_directory(data / "ipc-toolkit"))
-    for (const char* file : {"two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"})
+    for (const char* file :
+         {"two-cubes-far.ply", "two-cubes-close.ply", "two-cubes-intersecting.ply"})
       if (fs::exists(data / "ipc-toolkit" / file))
         data_cases.push_back(
             sequence_case(std::string("ipc ") + file, (data / "ipc-toolkit" / file).string()));

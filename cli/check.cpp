@@ -220,8 +220,7 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
   const double per_frame = s.frames_checked > 0 ? s.check_seconds / s.frames_checked : 0.0;
   out << "time                 " << fixed(s.check_seconds, 3) << " s checking ("
       << fixed(per_frame * 1e3, 2) << " ms per frame), " << fixed(s.read_seconds, 3)
-      << " s reading (ahead, on other threads), " << fixed(totals.wall_seconds, 3)
-      << " s in all\n";
+      << " s reading (ahead, on other threads), " << fixed(totals.wall_seconds, 3) << " s in all\n";
   out << "tree                 " << plural(totals.builds, "build") << ", "
       << plural(totals.rebuilds, "rebuild") << " (--rebuild " << rebuild_policy << "), "
       << plural(s.topology_changes, "topology change") << "\n";
@@ -421,8 +420,8 @@ int run_check(const CheckOptions& o) {
   if (!o.out_dir.empty()) report_dir = o.out_dir;
   // Frames are formatted side by side when they come faster than one thread formats them (a
   // GPU's checks of many pairs); the formatters idle otherwise.
-  report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings),
-                               inputs.objects, threads);
+  report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings), inputs.objects,
+                               threads);
 
   SequenceSettings sequence;
   sequence.weld = o.weld;

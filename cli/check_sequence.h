@@ -20,19 +20,19 @@ namespace snag::cli {
 /// Where the frame loop's time went, in seconds summed over frames: on the loop's thread (the
 /// checker's), and beside it on the preparing thread and, on a GPU, the recording thread.
 struct LoopTimes {
-  double waiting = 0;    ///< for the next frame, not yet read or compared
-  double preparing = 0;  ///< a topology's set-up (weld decisions, the checker's scene, meters)
-  double checking = 0;   ///< Checker::check, exact decisions included
+  double waiting = 0;         ///< for the next frame, not yet read or compared
+  double preparing = 0;       ///< a topology's set-up (weld decisions, the checker's scene, meters)
+  double checking = 0;        ///< Checker::check, exact decisions included
   detect::StageTimes stages;  ///< checking by the checker's own stage clocks (FrameResult::times)
-  double recording = 0;  ///< the frame's record: ids, groups, penetration (on a GPU, beside
-                         ///< the loop on the recording thread, one frame behind the checks)
-  double handing = 0;    ///< on_frame (the report stream takes the record; where recording is)
-  double behind = 0;     ///< on a GPU, for the frame before's record and hand-over to be done
-  double starting = 0;   ///< of waiting and preparing, until the first frame's check began
-  double comparing = 0;  ///< on the preparing thread: vertex counts, faces and what moved,
-                         ///< each frame against the one before (reading's share)
-  double staging = 0;    ///< on the preparing thread: positions copied into the backend's
-                         ///< staging memory (a GPU's pinned buffers; none on the CPU)
+  double recording = 0;       ///< the frame's record: ids, groups, penetration (on a GPU, beside
+                              ///< the loop on the recording thread, one frame behind the checks)
+  double handing = 0;         ///< on_frame (the report stream takes the record; where recording is)
+  double behind = 0;          ///< on a GPU, for the frame before's record and hand-over to be done
+  double starting = 0;        ///< of waiting and preparing, until the first frame's check began
+  double comparing = 0;       ///< on the preparing thread: vertex counts, faces and what moved,
+                              ///< each frame against the one before (reading's share)
+  double staging = 0;         ///< on the preparing thread: positions copied into the backend's
+                              ///< staging memory (a GPU's pinned buffers; none on the CPU)
 };
 
 struct SequenceSettings {

@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
       "triangle pair of every frame, labelled crossing or touching.",
       "snag"};
   try {
-    app.set_version_flag("--version", std::string("snag ") + SNAG_VERSION + "\n" +
-                                          snag::cli::cuda_build_line());
+    app.set_version_flag("--version",
+                         std::string("snag ") + SNAG_VERSION + "\n" + snag::cli::cuda_build_line());
     // CLI11's own messages (a bad value, an unknown option) start as snag's do; set before the
     // subcommands are added, which copy it.
     app.failure_message([](const CLI::App* failed, const CLI::Error& e) {

@@ -43,7 +43,7 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d) {
 
 bool inside(Point2 p, Point2 a, Point2 b, Point2 c) {
   const double s1 = orient(a, b, p), s2 = orient(b, c, p), s3 = orient(c, a, p);
-  const bool negative = s1 < 0 || s2 < 0 || s3 < 0, positive = s1 > 0 || s2 > 0 || s3 > 0;
+  const bool negative = s1 < 0 || s2 < 0 || s3<0, positive = s1> 0 || s2 > 0 || s3 > 0;
   return !(negative && positive);
 }
 
@@ -160,9 +160,9 @@ std::optional<detect::PairKind> intersect(std::span<const geom::Vec3d> positions
     if (dot(n, s - p) != 0) return std::nullopt;
     const int axis = largest_axis(n);
     const Point2 p2 = project(p, axis), q2 = project(q, axis);
-    const double side_r = orient(p2, q2, project(r, axis)), side_s = orient(p2, q2, project(s, axis));
-    if ((side_r > 0 && side_s > 0) || (side_r < 0 && side_s < 0))
-      return detect::PairKind::touching;
+    const double side_r = orient(p2, q2, project(r, axis)),
+                 side_s = orient(p2, q2, project(s, axis));
+    if ((side_r > 0 && side_s > 0) || (side_r < 0 && side_s < 0)) return detect::PairKind::touching;
     return std::nullopt;
   }
   if (shared == 1) {
@@ -175,7 +175,8 @@ std::optional<detect::PairKind> intersect(std::span<const geom::Vec3d> positions
 }
 
 bool degenerate(std::span<const geom::Vec3d> positions, const geom::Tri& t) {
-  const Vec3d n = cross(positions[t.v[1]] - positions[t.v[0]], positions[t.v[2]] - positions[t.v[0]]);
+  const Vec3d n =
+      cross(positions[t.v[1]] - positions[t.v[0]], positions[t.v[2]] - positions[t.v[0]]);
   return n.x == 0 && n.y == 0 && n.z == 0;
 }
 

@@ -47,7 +47,8 @@ inline std::vector<std::string> split_csv_line(const std::string& line, size_t f
   return out;
 }
 
-inline std::vector<std::string> csv_rows(const std::filesystem::path& path, const std::string& header) {
+inline std::vector<std::string> csv_rows(const std::filesystem::path& path,
+                                         const std::string& header) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read " + path.string());
   std::vector<std::string> rows;
@@ -116,9 +117,9 @@ struct LoadedCase {
 inline LoadedCase load(const CorpusCase& c) {
   LoadedCase out{io::read_mesh(corpus_dir() / c.file), {}};
   out.triangles = mesh::welded_triangles(
-      out.mesh.triangles,
-      c.weld.empty() ? std::vector<int32_t>{}
-                     : mesh::weld_representatives(out.mesh.positions, std::stod(c.weld)));
+      out.mesh.triangles, c.weld.empty()
+                              ? std::vector<int32_t>{}
+                              : mesh::weld_representatives(out.mesh.positions, std::stod(c.weld)));
   return out;
 }
 

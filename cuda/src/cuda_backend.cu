@@ -327,7 +327,7 @@ class CudaBackendImpl final : public CudaBackend {
     const std::vector<int32_t> refit =
         queued_ahead ? std::move(ahead_.refit) : queue_frame(parts, view, timer_);
     EventTimer& timer = queued_ahead ? ahead_timer_ : timer_;
-    copy_staged_positions();  // the next frame's, while the device works on this one
+    copy_staged_positions();        // the next frame's, while the device works on this one
     times_.scan = timer.elapsed();  // the wait: scan, refits and qualities done
     collect_times();
     for (int32_t p : refit) {
@@ -790,12 +790,12 @@ class CudaBackendImpl final : public CudaBackend {
   // The scan and the qualities queued ahead (scan_degenerate_parts), beside the main stream's
   // refits and walks; the host waits for it before each scan returns.
   std::unique_ptr<Stream> side_stream_;
-  Event refits_queued_;     // the main stream's refits queued ahead by a scan
-  Event pinned_copied_[2];  // the last copy out of each pinned buffer
-  Event slot_released_;     // main-stream work queued before a staged copy
+  Event refits_queued_;            // the main stream's refits queued ahead by a scan
+  Event pinned_copied_[2];         // the last copy out of each pinned buffer
+  Event slot_released_;            // main-stream work queued before a staged copy
   bool release_recorded_ = false;  // slot_released_ recorded by queue_ahead for the next staging
   int released_slot_ = 0;          // the slot it released
-  Event staged_ready_;      // the staged copy
+  Event staged_ready_;             // the staged copy
   bool staged_ = false;
   bool staged_copy_pending_ = false;  // staged_, its host copy not made yet (copy_staged_positions)
   const geom::Vec3d* staged_data_ = nullptr;  // the staged frame, as the caller holds it
@@ -817,9 +817,9 @@ class CudaBackendImpl final : public CudaBackend {
   // while the host decodes the other. results_set_ is the one the next run writes.
   PinnedBuffer<FrameCounters> counters_host_[2];
   PinnedBuffer<uint64_t> host_pairs_[2], host_uncertain_[2];  // pairs: keys with their status
-  HostResults host_results_[2];  // device addresses of each set
+  HostResults host_results_[2];                               // device addresses of each set
   int results_set_ = 0;
-  DeviceBuffer<ScanCounters> scan_counters_;   // zero between scans (the scan leaves them so)
+  DeviceBuffer<ScanCounters> scan_counters_;  // zero between scans (the scan leaves them so)
   bool scan_pending_ = false;  // a scan's launches queued, its counts not yet read and accepted
   PinnedBuffer<ScanCounts> scan_counts_host_;  // the last scan's counts, written by its kernel
   DetectCall last_detect_;
@@ -834,8 +834,8 @@ class CudaBackendImpl final : public CudaBackend {
   };
   Ahead ahead_;
   AheadTaken ahead_taken_;
-  EventTimer ahead_timer_;  // from the staged positions ready to the ahead's side stream done
-  bool scanned_ = false;    // the current frame's positions went through a scan
+  EventTimer ahead_timer_;     // from the staged positions ready to the ahead's side stream done
+  bool scanned_ = false;       // the current frame's positions went through a scan
   uint64_t tree_changes_ = 0;  // builds and refits queued: a detect queued ahead read the trees
   unsigned max_blocks_ = 1;
   EventTimer detect_timer_;
@@ -959,9 +959,12 @@ void CudaBackendImpl::queue_detect(detect::FilterUse use, std::span<const int32_
       FanJob part_fans;
       if (fans) {
         const int32_t first = topology_->layout.vertex_begin[check.a];
-        part_fans = {view.positions, planes_.data(),
-                     {topo_.fan_begin.data(), topo_.fan_steps.data()}, first,
-                     topology_->layout.vertex_begin[check.a + 1] - first, topo_.fan_clear.data()};
+        part_fans = {view.positions,
+                     planes_.data(),
+                     {topo_.fan_begin.data(), topo_.fan_steps.data()},
+                     first,
+                     topology_->layout.vertex_begin[check.a + 1] - first,
+                     topo_.fan_clear.data()};
       }
       if (part_size(check.a) > 0)
         launch_self_check(trees_[check.a]->view(), part_begin(check.a), inputs, part_fans, drop,
@@ -1053,11 +1056,10 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   for (int32_t c : checks)
     for (int32_t p : {topology_->checks[c].a, topology_->checks[c].b})
       if (needs_refit(p, view)) queue_refit(p, /*timed=*/true, view);
-  const bool speculated =
-      speculation_.queued && speculation_.call.use == use &&
-      std::ranges::equal(speculation_.call.checks, checks) &&
-      std::ranges::equal(speculation_.degenerate, degenerate) &&
-      speculation_.tree_changes == tree_changes_ && speculation_.view == view;
+  const bool speculated = speculation_.queued && speculation_.call.use == use &&
+                          std::ranges::equal(speculation_.call.checks, checks) &&
+                          std::ranges::equal(speculation_.degenerate, degenerate) &&
+                          speculation_.tree_changes == tree_changes_ && speculation_.view == view;
   speculation_.queued = false;
   ahead_taken_.detects += speculated && speculation_.ahead;
   // The set the run writes in host memory; a detect queued ahead writes the other one.
@@ -1160,11 +1162,11 @@ detect::FilteredFrame CudaBackendImpl::detect_checks(std::span<const int32_t> de
   const auto task_count = static_cast<size_t>(c.uncertain);
   const int64_t uncertain_kinds =
       large_pairs
-          ? decode_pairs(pair_count, frame,
-                         [&](size_t i) {
-                           return std::pair<uint64_t, uint8_t>{keys_host_.data()[i],
-                                                               status_host_.data()[i]};
-                         })
+          ? decode_pairs(
+                pair_count, frame,
+                [&](size_t i) {
+                  return std::pair<uint64_t, uint8_t>{keys_host_.data()[i], status_host_.data()[i]};
+                })
           : decode_pairs(pair_count, frame, [&](size_t i) {
               const uint64_t packed = host_pairs_[set].data()[i];
               return std::pair<uint64_t, uint8_t>{packed & ((uint64_t{1} << kStatusShift) - 1),
@@ -1261,9 +1263,9 @@ std::string cuda_device_problem(int device) {
   if (status == cudaErrorNoKernelImageForDevice || status == cudaErrorInvalidDeviceFunction ||
       status == cudaErrorUnsupportedPtxVersion)
     return which + " cannot run this build's kernels, compiled for CUDA architectures " +
-           SNAG_CUDA_ARCHITECTURES_TEXT + ": rebuild with -DSNAG_CUDA_ARCHITECTURES=" +
-           std::to_string(prop.major) + std::to_string(prop.minor) + " (" +
-           runtime_error_text(status) + ")";
+           SNAG_CUDA_ARCHITECTURES_TEXT +
+           ": rebuild with -DSNAG_CUDA_ARCHITECTURES=" + std::to_string(prop.major) +
+           std::to_string(prop.minor) + " (" + runtime_error_text(status) + ")";
   return which + " cannot be used: " + runtime_error_text(status);
 }
 

@@ -3,9 +3,9 @@
 #include <thrust/iterator/transform_iterator.h>
 
 #include <algorithm>
-#include <cuda/atomic>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
+#include <cuda/atomic>
 
 #include "launch.cuh"
 #include "snag/detect/pair_test.h"
@@ -223,8 +223,8 @@ __device__ __forceinline__ geom::Box3f shuffle_box(const geom::Box3f& box, int s
 /// one subtree's level (count a power of two, at most 32): fits and stores their ancestors up
 /// to that subtree's root, whose box lane 0 returns; `first` ends as the root. Every lane of
 /// the warp calls it.
-__device__ geom::Box3f fit_up_in_warp(float* stage, geom::Box3f* boxes, geom::Box3f box,
-                                      int count, int32_t& first) {
+__device__ geom::Box3f fit_up_in_warp(float* stage, geom::Box3f* boxes, geom::Box3f box, int count,
+                                      int32_t& first) {
   const int lane = static_cast<int>(threadIdx.x & 31);
   for (; count > 1; count /= 2) {
     const geom::Box3f left = shuffle_box(box, (2 * lane) & 31);
@@ -307,8 +307,8 @@ __global__ void __launch_bounds__(kRefitThreads)
   const int warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
   const int lanes = min(width, 32), warps = max(width / 32, 1);
   float* const warp_stage = stage.words[warp];
-  int32_t first = CompleteTree::level_begin(depth - 1) +
-                  static_cast<int32_t>(blockIdx.x) * width + warp * 32;
+  int32_t first =
+      CompleteTree::level_begin(depth - 1) + static_cast<int32_t>(blockIdx.x) * width + warp * 32;
   if (warp < warps) {
     const int32_t node = first + lane;
     const bool mine = lane < lanes;

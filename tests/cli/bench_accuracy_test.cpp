@@ -36,8 +36,8 @@ TEST(CliBench, AccuracyScoresTheHardCasesAgainstTheExactAnswer) {
     const long kinds = row[8] == "n/a" ? 0 : std::stol(row[8]);
     return std::stol(row[6]) + std::stol(row[7]) + kinds;
   };
-  for (const char* exact : {"snag cpu --exact uncertain", "snag cpu --exact all",
-                            "CGAL self_intersections"}) {
+  for (const char* exact :
+       {"snag cpu --exact uncertain", "snag cpu --exact all", "CGAL self_intersections"}) {
     EXPECT_EQ(wrong(exact), 0) << exact;
     EXPECT_EQ(by_method.at(exact)[9], "0") << exact;
   }

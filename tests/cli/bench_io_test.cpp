@@ -13,10 +13,10 @@ namespace {
 
 TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   TempDir tmp;
-  const RunResult r = run_snag_without_data({"bench", "io", "--size", "800", "--frames", "8",
-                                             "--passes", "1", "--memory-frames", "2,8",
-                                             "--threads", "2"},
-                                            tmp.path());
+  const RunResult r =
+      run_snag_without_data({"bench", "io", "--size", "800", "--frames", "8", "--passes", "1",
+                             "--memory-frames", "2,8", "--threads", "2"},
+                            tmp.path());
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* format : {"OBJ", "PLY binary", "PLY ascii"}) {
     const std::vector<std::string> rates = table_row(r.out, std::string("cloth 800 ") + format);
@@ -49,7 +49,7 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
   EXPECT_EQ(loop[5], "0.000");                    // behind
   EXPECT_EQ(loop[6], cpu[3]);                     // the loop is snag check's time
   EXPECT_LE(shares, std::stod(loop[6]) + 0.006);  // three decimals each, rounded
-  EXPECT_GE(std::stod(loop[7]), 0);  // starting, of waiting and preparing
+  EXPECT_GE(std::stod(loop[7]), 0);               // starting, of waiting and preparing
   EXPECT_LE(std::stod(loop[7]), std::stod(loop[0]) + std::stod(loop[1]) + 0.001);
   EXPECT_GE(std::stod(loop[8]), 0);  // comparing (microseconds a frame here)
   EXPECT_EQ(loop[9], "0.000");       // staging

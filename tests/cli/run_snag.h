@@ -26,8 +26,7 @@ RunResult run_snag_without_data(const std::vector<std::string>& args,
 
 /// The whitespace-separated words after `prefix` of the `nth` line (from 0) of `text` that
 /// starts with it (a row of a bench table); a test failure and no words when there is none.
-std::vector<std::string> table_row(const std::string& text, const std::string& prefix,
-                                   int nth = 0);
+std::vector<std::string> table_row(const std::string& text, const std::string& prefix, int nth = 0);
 
 /// A fresh directory under the system temporary directory, removed with its contents.
 class TempDir {

@@ -142,8 +142,8 @@ TEST(CudaTree, RefitStrategiesGiveTheCpuBoxes) {
   // the last block's first warp takes the blocks' roots (2 to 256 of them: one a lane up to
   // 8,192 leaves, two, four, then eight from 32,769), and past 2^16 leaves the whole block
   // merges the widest levels above them first (cuda/src/device_tree.cu).
-  for (int32_t n : {1, 2, 3, 5, 20, 40, 77, 128, 129, 257, 512, 513, 1000, 1500, 3000, 5000, 10000,
-                    20000, 33333, 70000, 300001}) {
+  for (int32_t n : {1,   2,    3,    5,    20,   40,    77,    128,   129,   257,   512,
+                    513, 1000, 1500, 3000, 5000, 10000, 20000, 33333, 70000, 300001}) {
     SmallMesh soup = random_soup(n, 11 + static_cast<uint32_t>(n), 0.3);
     const detect::Topology topology =
         detect::make_topology(soup.triangles, static_cast<int32_t>(soup.positions.size()));
@@ -530,9 +530,12 @@ TEST(CudaDetect, FanClearedNeighboursLeftOutCountAsOnTheCpu) {
   SmallMesh degenerate = sheet(4);
   degenerate.positions[degenerate.triangles[500].v[0]] =
       degenerate.positions[degenerate.triangles[500].v[1]];
-  const std::vector<std::pair<std::string, SmallMesh>> frames = {
-      {"flat", flat},           {"ripples 4", sheet(4)}, {"zero-area faces", degenerate},
-      {"ripples 12", sheet(12)}, {"ripples 40", sheet(40)}, {"folded", folded_grid(w, h)}};
+  const std::vector<std::pair<std::string, SmallMesh>> frames = {{"flat", flat},
+                                                                 {"ripples 4", sheet(4)},
+                                                                 {"zero-area faces", degenerate},
+                                                                 {"ripples 12", sheet(12)},
+                                                                 {"ripples 40", sheet(40)},
+                                                                 {"folded", folded_grid(w, h)}};
   for (size_t f = 0; f < frames.size(); ++f) {
     const auto& [what, mesh] = frames[f];
     const Filtered c = filtered(*cpu, mesh.positions, f == 0);
@@ -877,7 +880,8 @@ TEST(CudaBackend, FramesQueuedAheadGiveThePlainAnswers) {
   for (int64_t capacity : {int64_t{0}, int64_t{1}}) {
     auto [cpu, gpu] = both_backends(topology, capacity);
     for (int f = 0; f < 14; ++f) {
-      const std::string what = "capacity " + std::to_string(capacity) + " frame " + std::to_string(f);
+      const std::string what =
+          "capacity " + std::to_string(capacity) + " frame " + std::to_string(f);
       const bool build = f == 0 || f == 7;  // frame 7: a rebuild after its work was queued ahead
       // Frame 11 is checked with frame 12 staged, then an unrelated frame of the same size comes.
       const std::span<const geom::Vec3d> positions =

@@ -3,7 +3,6 @@
 // crossing/touching kinds against CGAL's exact intersection construction.
 #include <gtest/gtest.h>
 
-
 #include <filesystem>
 #include <random>
 

@@ -63,11 +63,12 @@ TEST(ExactModes, UncertainAndAllAgreeWithEachOtherAndWithCgal) {
     const Soup soup = rounded_lattice_soup(90, seed, seed % 2 ? 0.1 : 0.3, seed % 3 ? 0.7 : 1e6);
     const Pairs expected = cgal_soup_self_intersections(soup.positions, soup.triangles);
     for (int threads : {1, 3}) {
-      const std::string what = "seed " + std::to_string(seed) + ", threads " +
-                               std::to_string(threads);
+      const std::string what =
+          "seed " + std::to_string(seed) + ", threads " + std::to_string(threads);
       const detect::FrameResult uncertain =
           check(soup.positions, soup.triangles, ExactMode::uncertain, threads);
-      const detect::FrameResult all = check(soup.positions, soup.triangles, ExactMode::all, threads);
+      const detect::FrameResult all =
+          check(soup.positions, soup.triangles, ExactMode::all, threads);
       ASSERT_EQ(uncertain.pairs, all.pairs) << what;  // kinds included
       ASSERT_EQ(uncertain.degenerate, all.degenerate) << what;
       ASSERT_EQ(pair_ids(all.pairs), expected) << what;
@@ -121,9 +122,8 @@ TEST(ExactModes, AllOnSharedDataFilesMatchesUncertain) {
 
 /// Two triangles: the second stands through the first (a crossing), and a third far away.
 struct Three {
-  std::vector<geom::Vec3d> positions{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {1, 1, -1},
-                                     {1, 1, 1},  {2, 2, 1}, {9, 9, 9}, {10, 9, 9},
-                                     {9, 10, 9}};
+  std::vector<geom::Vec3d> positions{{0, 0, 0}, {4, 0, 0}, {0, 4, 0},  {1, 1, -1}, {1, 1, 1},
+                                     {2, 2, 1}, {9, 9, 9}, {10, 9, 9}, {9, 10, 9}};
   std::vector<geom::Tri> triangles{{{0, 1, 2}}, {{3, 4, 5}}, {{6, 7, 8}}};
 };
 
@@ -201,9 +201,9 @@ TEST(ExactModes, FramesVouchedFiniteGiveTheSameAnswers) {
 TEST(ExactModes, NanAndInfinityAreInputErrorsInEveryMode) {
   // Readers reject such files; the checker itself must not answer (NaN compares false, so
   // pairs vanish) nor crash (CGAL traps converting infinity to an exact number).
-  for (double bad : {std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity()})
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity()})
     for (ExactMode mode : {ExactMode::off, ExactMode::uncertain, ExactMode::all}) {
       Three m;
       m.positions[5].x = bad;

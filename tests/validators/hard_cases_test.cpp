@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "hard_corpus.h"
 #include "snag/detect/checker.h"
 #include "snag/detect/cpu_backend.h"
 #include "snag/detect/exact.h"
@@ -25,7 +26,6 @@
 #include "snag/mesh/weld.h"
 #include "snag/validators/cgal_reference.h"
 #include "snag/validators/exact_modes.h"
-#include "hard_corpus.h"
 #include "test_paths.h"
 
 namespace snag::validators {

@@ -252,15 +252,9 @@ class CpuBackend final : public Backend {
     return scan;
   }
 
-  void build_part(int32_t part) override {
-    trees_[part].build(part_view(part), threads_);
-  }
-  void refit_part(int32_t part) override {
-    trees_[part].refit(part_view(part), threads_);
-  }
-  double part_quality(int32_t part) override {
-    return trees_[part].quality(threads_);
-  }
+  void build_part(int32_t part) override { trees_[part].build(part_view(part), threads_); }
+  void refit_part(int32_t part) override { trees_[part].refit(part_view(part), threads_); }
+  double part_quality(int32_t part) override { return trees_[part].quality(threads_); }
 
   FilteredFrame detect_checks(std::span<const int32_t> degenerate, FilterUse use,
                               std::span<const int32_t> checks) override {
@@ -269,9 +263,7 @@ class CpuBackend final : public Backend {
   }
 
  protected:
-  int32_t part_count() const override {
-    return topology_ ? topology_->part_count() : 0;
-  }
+  int32_t part_count() const override { return topology_ ? topology_->part_count() : 0; }
   int32_t check_count() const override {
     return topology_ ? static_cast<int32_t>(topology_->checks.size()) : 0;
   }

@@ -379,7 +379,7 @@ class ObjParser {
   const std::string& name_;
   int64_t line_ = 1;
   mesh::Mesh mesh_;
-  std::vector<int32_t> corners_;  // reused for every face: no allocation per line
+  std::vector<int32_t> corners_;    // reused for every face: no allocation per line
   detail::DecimalShape shapes_[3];  // the x, y and z columns' last layouts (parse_shaped)
   uint8_t index_lengths_[3] = {};   // plain triangles' corner columns (parse_shaped_index)
   std::vector<ForwardReference> forward_;

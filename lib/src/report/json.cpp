@@ -17,10 +17,10 @@ namespace {
 using nlohmann::ordered_json;
 
 ordered_json seconds_json(const FrameRecord& f) {
-  return {{"read", f.read_seconds},       {"scan", f.times.scan},
-          {"build", f.times.build},       {"refit", f.times.refit},
-          {"traverse", f.times.traverse}, {"exact", f.times.exact},  {"classify", f.times.classify},
-          {"confirm", f.times.confirm},   {"total", f.times.total()}};
+  return {
+      {"read", f.read_seconds},       {"scan", f.times.scan},         {"build", f.times.build},
+      {"refit", f.times.refit},       {"traverse", f.times.traverse}, {"exact", f.times.exact},
+      {"classify", f.times.classify}, {"confirm", f.times.confirm},   {"total", f.times.total()}};
 }
 
 /// Object `index` of a scene run, for a record's `what` (an InternalError when the record names
