@@ -173,6 +173,70 @@ TEST(Tree, BuildSplitsEachSegmentAlongTheLongestAxis) {
               soup.positions[3 * tree.triangle_at()[p]].x);
 }
 
+/// The build as documented, written independently: every internal node's segment (its leaf
+/// positions) sorted in full by (centroid coordinate, triangle id) along the longest axis of the
+/// segment's centroid bounds, ties between axes going to x, then y. Exact for integer corners.
+std::vector<int32_t> reference_build_order(const Soup& soup) {
+  const auto n = static_cast<int32_t>(soup.triangles.size());
+  const CompleteTree shape(n);
+  std::vector<int32_t> order(static_cast<size_t>(n));
+  for (int32_t t = 0; t < n; ++t) order[t] = t;
+  auto centroid = [&](int32_t t, int axis) {
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) sum += geom::coord(soup.positions[soup.triangles[t].v[k]], axis);
+    return sum;
+  };
+  for (int32_t node = 0; node < n - 1; ++node) {  // breadth-first: parents before children
+    int32_t begin, end;
+    shape.positions_under(node, begin, end);
+    double extent[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      double lo = centroid(order[begin], axis), hi = lo;
+      for (int32_t p = begin; p < end; ++p) {
+        lo = std::min(lo, centroid(order[p], axis));
+        hi = std::max(hi, centroid(order[p], axis));
+      }
+      extent[axis] = hi - lo;
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (extent[k] > extent[axis]) axis = k;
+    std::sort(order.begin() + begin, order.begin() + end, [&](int32_t a, int32_t b) {
+      const double ca = centroid(a, axis), cb = centroid(b, axis);
+      return ca != cb ? ca < cb : a < b;
+    });
+  }
+  return order;
+}
+
+TEST(Tree, BuildBreaksTiesOfAxesByAxisOrderAndOfCentroidsByTriangleId) {
+  // Found by mutation testing: the builds of these trees with the axis ties or the centroid
+  // ties broken the other way passed every other CPU test (the CUDA tests compare with the
+  // GPU's build, which breaks them this way). Triangles on a small integer lattice: many share a
+  // centroid, and segments' extents tie between axes (x = y = z; then y = z alone).
+  for (const int x_cells : {4, 2}) {
+    for (const int32_t n : {7, 100, 515}) {
+      SCOPED_TRACE("n=" + std::to_string(n) + " x cells=" + std::to_string(x_cells));
+      std::mt19937 rng(static_cast<uint32_t>(n * 10 + x_cells));
+      std::uniform_int_distribution<int> cell(0, 3), x_cell(0, x_cells - 1);
+      Soup soup;
+      for (int32_t t = 0; t < n; ++t) {
+        const double x = x_cell(rng), y = cell(rng), z = cell(rng);
+        soup.positions.push_back({x, y, z});
+        soup.positions.push_back({x + 1, y, z});
+        soup.positions.push_back({x, y + 1, z + 1});
+        soup.triangles.push_back({{3 * t, 3 * t + 1, 3 * t + 2}});
+      }
+      const std::vector<int32_t> expected = reference_build_order(soup);
+      for (int threads : {1, 2}) {
+        Tree tree;
+        tree.build(soup_view(soup), threads);
+        ASSERT_EQ(tree.triangle_at(), expected) << threads << " threads";
+      }
+    }
+  }
+}
+
 using PairMultiset = std::multiset<std::pair<int32_t, int32_t>>;
 
 /// Every pair the per-leaf walk visits, as (smaller id, larger id), with repetitions.

@@ -594,5 +594,42 @@ TEST(Closed, BadCornersPinchPointsAndEmptyLists) {
             "in different ones)");
 }
 
+// ---------------------------------------------------------------------------------------------
+// Clearance at its edge (found by mutation testing: a margin added instead of subtracted kept
+// every earlier test passing, the random steps of ClearanceSkipsOnlyPointsProvenOutside never
+// landing within 1e-9 of a distance).
+
+TEST(Penetration, ClearanceRemeasuresAPointThatMovedJustPastItsDistance) {
+  // A point 1 below the unit cube's bottom face, then moved straight up by 1 + 5e-10: it is
+  // now 5e-10 inside (the bottom face is its closest), a depth worked out by hand. Its movement
+  // exceeds its distance, so the clearance must not skip it, however small the excess.
+  const PenetrationMeter meter = meter_for(cube());
+  Clearance clearance;
+  const double z = 5e-10;
+  std::vector<double> depths;
+  EXPECT_EQ(meter.measure(std::vector<Vec3d>{{0.5, 0.5, -1.0}}, clearance, 1, &depths).inside, 0);
+  EXPECT_EQ(depths[0], 0.0);
+  const PenetrationStats moved =
+      meter.measure(std::vector<Vec3d>{{0.5, 0.5, z}}, clearance, 1, &depths);
+  EXPECT_EQ(moved.proven_outside, 0);
+  EXPECT_EQ(moved.inside, 1);
+  EXPECT_DOUBLE_EQ(depths[0], z);
+
+  // The same with the obstacle's travel making up most of it: the cube moves down by 0.5 and
+  // the point up by 0.5 + 5e-10, ending 5e-10 above the moved bottom face (z = -0.5).
+  Surface s = cube();
+  PenetrationMeter moving = meter_for(s);
+  Clearance second;
+  EXPECT_EQ(moving.measure(std::vector<Vec3d>{{0.5, 0.5, -1.0}}, second, 1, &depths).inside, 0);
+  for (Vec3d& v : s.positions) v = v + Vec3d{0.0, 0.0, -0.5};
+  moving.update_positions(s.positions, 1);
+  EXPECT_EQ(moving.travel(), 0.5);
+  const PenetrationStats both =
+      moving.measure(std::vector<Vec3d>{{0.5, 0.5, -0.5 + z}}, second, 1, &depths);
+  EXPECT_EQ(both.proven_outside, 0);
+  EXPECT_EQ(both.inside, 1);
+  EXPECT_NEAR(depths[0], z, 1e-16);
+}
+
 }  // namespace
 }  // namespace snag::measure

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "snag/error.h"
+#include "snag/scene/scene_frames.h"
 
 namespace snag::scene {
 namespace {
@@ -439,6 +440,112 @@ TEST(SceneFromFlags, CollidingNamesGetSuffixes) {
   EXPECT_EQ(scene.objects[0].against,
             (Names{"body", "body-2", "cloth-2", "body-3", "body-4", "cloth-3"}));
   EXPECT_EQ(scene.cross_checks().size(), 6u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Found by mutation testing: each of these passed with a wrong change to scene.cpp or
+// scene_frames.cpp before.
+
+TEST(SceneFromFlags, ThreeOrMoreTrailingDigitsAreAFrameNumberFewerAreKept) {
+  // scene_from_flags: "digits after a separator, or 3 or more" are frame digits.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"body001.obj", "body"},  {"body123.ply", "body"}, {"scan007.%04d.obj", "scan"},
+      {"body12.obj", "body12"}, {"v2.obj", "v2"},
+  };
+  for (const auto& [sequence, name] : cases) {
+    EXPECT_EQ(scene_from_flags("c.obj", {sequence}, std::nullopt).objects[1].name, name)
+        << sequence;
+  }
+}
+
+/// One triangle a little off the origin, as an OBJ.
+std::string one_triangle_obj(double offset) {
+  const std::string o = std::to_string(offset);
+  return "v " + o + " 0 0\nv 1 " + o + " 0\nv 0 1 " + o + "\nf 1 2 3\n";
+}
+
+std::vector<int64_t> numbers_of(const std::vector<seq::Frame>& frames) {
+  std::vector<int64_t> numbers;
+  for (const seq::Frame& f : frames) numbers.push_back(f.number);
+  return numbers;
+}
+
+TEST_F(SceneFile, TheFirstClothSetsTheFramesEvenWhenAnObstacleIsListedFirst) {
+  for (int f = 1; f <= 3; ++f) write("dress.000" + std::to_string(f) + ".obj", one_triangle_obj(f));
+  const std::string body = write("body.obj", one_triangle_obj(5));
+  Scene scene;
+  ObjectSpec obstacle;
+  obstacle.name = "body";
+  obstacle.sequence = body;
+  obstacle.role = Role::obstacle;
+  obstacle.self = false;
+  ObjectSpec cloth;
+  cloth.name = "dress";
+  cloth.sequence = (dir_ / "dress.%04d.obj").string();
+  cloth.against = {"body"};
+  scene.objects = {obstacle, cloth};
+  const ResolvedScene resolved = resolve_scene(scene, "");
+  EXPECT_EQ(numbers_of(resolved.frames), (std::vector<int64_t>{1, 2, 3}));
+  ASSERT_EQ(resolved.objects.size(), 2u);
+  EXPECT_TRUE(resolved.objects[0].still);
+  EXPECT_FALSE(resolved.objects[1].still);
+  EXPECT_EQ(resolved.objects[1].frames, resolved.frames);
+  EXPECT_EQ(resolved.objects[1].frames[2].path, dir_ / "dress.0003.obj");
+  EXPECT_EQ(resolved.checks, (std::vector<detect::PartCheck>{{0, 1}, {1, 1}}));
+  const ResolvedScene selected = resolve_scene(scene, "2-3");
+  EXPECT_EQ(numbers_of(selected.frames), (std::vector<int64_t>{2, 3}));
+}
+
+TEST_F(SceneFile, ASecondClothOfOneFileIsStill) {
+  // "an object with a single file that is not one of several frames is still", whatever its
+  // role: a second cloth of one file is read once and checked in every frame.
+  for (int f = 1; f <= 3; ++f) write("dress.000" + std::to_string(f) + ".obj", one_triangle_obj(f));
+  const std::string patch = write("patch.obj", one_triangle_obj(7));
+  Scene scene;
+  ObjectSpec dress;
+  dress.name = "dress";
+  dress.sequence = (dir_ / "dress.%04d.obj").string();
+  dress.against = {"patch"};
+  ObjectSpec second;
+  second.name = "patch";
+  second.sequence = patch;
+  scene.objects = {dress, second};
+  const ResolvedScene resolved = resolve_scene(scene, "");
+  EXPECT_EQ(numbers_of(resolved.frames), (std::vector<int64_t>{1, 2, 3}));
+  ASSERT_EQ(resolved.objects.size(), 2u);
+  EXPECT_TRUE(resolved.objects[1].still);
+  const SceneReader reader(resolved);
+  std::vector<io::FrameReader> readers = reader.make_readers();
+  for (size_t i = 0; i < 3; ++i) {
+    const SceneFrame frame = reader.read(i, readers);
+    ASSERT_EQ(frame.mesh.triangles.size(), 2u);
+    EXPECT_EQ(frame.files[1], patch);
+    EXPECT_EQ(frame.mesh.positions[3].x, 7.0);  // the patch's first vertex, after the dress's 3
+  }
+}
+
+TEST_F(SceneFile, ASceneOfOneGroupObjectReadsOnlyThatGroup) {
+  // shirt.obj: sleeve (triangles 0 and 2) and collar (triangle 1, vertices 1, 2, 3 of the
+  // file); a scene of the collar alone has its one triangle and three vertices.
+  const std::string shirt = write("shirt.obj",
+                                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n"
+                                  "g sleeve\nf 1 2 4\ng collar\nf 1 2 3\ng sleeve\nf 2 3 5\n");
+  Scene scene;
+  ObjectSpec collar;
+  collar.name = "collar";
+  collar.sequence = shirt;
+  collar.group = "collar";
+  scene.objects = {collar};
+  const ResolvedScene resolved = resolve_scene(scene, "");
+  const SceneReader reader(resolved);
+  std::vector<io::FrameReader> readers = reader.make_readers();
+  const SceneFrame frame = reader.read(0, readers);
+  ASSERT_EQ(frame.mesh.triangles.size(), 1u);
+  EXPECT_EQ(frame.mesh.positions.size(), 3u);
+  EXPECT_EQ(frame.file_triangle, (std::vector<int32_t>{1}));
+  EXPECT_EQ(frame.file_vertex, (std::vector<int32_t>{0, 1, 2}));
+  EXPECT_EQ(frame.layout.triangle_begin, (std::vector<int32_t>{0, 1}));
+  EXPECT_EQ(frame.layout.vertex_begin, (std::vector<int32_t>{0, 3}));
 }
 
 }  // namespace
