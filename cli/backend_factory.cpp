@@ -23,7 +23,7 @@ std::string cuda_build_line() {
 #ifdef SNAG_HAVE_CUDA
   return "CUDA backend: " + cuda::cuda_build_description();
 #else
-  return "CUDA backend: not built (no CUDA compiler was found when this snag was built)";
+  return std::string("CUDA backend: not built (") + SNAG_WITHOUT_CUDA_BECAUSE + ")";
 #endif
 }
 
@@ -64,9 +64,10 @@ std::unique_ptr<detect::Backend> make_cuda(int device) {
   return cuda::make_cuda_backend(device);
 #else
   (void)device;
-  throw DeviceUnavailable(
-      "--backend cuda: this snag was built without the CUDA backend (no CUDA compiler was found "
-      "when it was built); use --backend cpu (or auto), or rebuild with the CUDA toolkit");
+  throw DeviceUnavailable(std::string("--backend cuda: this snag was built without the CUDA "
+                                      "backend (") +
+                          SNAG_WITHOUT_CUDA_BECAUSE +
+                          "); use --backend cpu (or auto), or rebuild with the CUDA toolkit");
 #endif
 }
 

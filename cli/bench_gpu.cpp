@@ -64,9 +64,8 @@ CLI::App* add_bench_gpu_command(CLI::App& bench, BenchGpuOptions& o) {
 #ifndef SNAG_HAVE_CUDA
 
 int run_bench_gpu(const BenchGpuOptions&) {
-  throw DeviceUnavailable(
-      "bench gpu: this snag was built without the CUDA backend (no CUDA compiler was found "
-      "when it was built)");
+  throw DeviceUnavailable(std::string("bench gpu: this snag was built without the CUDA backend (") +
+                          SNAG_WITHOUT_CUDA_BECAUSE + ")");
 }
 
 #else

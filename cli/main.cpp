@@ -115,6 +115,8 @@ int main(int argc, char** argv) {
       "snag finds where a cloth animation goes through itself: every intersecting "
       "triangle pair of every frame, labelled crossing or touching.",
       "snag"};
+  // What to do when a GPU runs out of memory: the commands with --backend can check on the CPU.
+  std::string out_of_memory_advice = "; run it on a GPU with more free memory";
   try {
     app.set_version_flag("--version",
                          std::string("snag ") + SNAG_VERSION + "\n" + snag::cli::cuda_build_line());
@@ -143,7 +145,7 @@ int main(int argc, char** argv) {
     // Set after the subcommands are added, so that they do not inherit it.
     app.footer(
         "Exit status: 0 clean, 1 intersections found (see check --fail-on), 2 usage error, "
-        "3 input or output error, 4 internal error. See snag(1).");
+        "3 input or output error, 4 internal or GPU error. See snag(1).");
 
     take_the_last_of_repeated_options(app);
 
@@ -158,6 +160,8 @@ int main(int argc, char** argv) {
       throw snag::UsageError("unknown command '" + std::string(argv[1]) + "'; expected " +
                              command_names(app));
     app.parse(argc, argv);
+    if (check_command->parsed() || bench_scene_command->parsed())
+      out_of_memory_advice = "; check it on the CPU with --backend cpu";
     int status = -1;
     if (check_command->parsed()) status = snag::cli::run_check(check);
     if (bench_cpu_command->parsed()) status = snag::cli::run_bench_cpu(bench);
@@ -183,8 +187,8 @@ int main(int argc, char** argv) {
   } catch (const snag::cli::DeviceUnavailable& e) {
     std::cerr << "snag: error: " << e.what() << "\n";
     return 4;
-  } catch (const snag::OutOfDeviceMemory& e) {
-    std::cerr << "snag: error: " << e.what() << "; check it with --backend cpu\n";
+  } catch (const snag::OutOfMemory& e) {
+    std::cerr << "snag: error: " << e.what() << out_of_memory_advice << "\n";
     return 4;
   } catch (const snag::InternalError& e) {
     std::cerr << "snag: internal error: " << e.what() << "\n";

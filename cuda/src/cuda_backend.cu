@@ -1273,8 +1273,8 @@ std::unique_ptr<detect::Backend> make_cuda_backend(int device) {
   const int count = cuda_device_count();
   if (count == 0) throw InternalError("no CUDA device is usable here (no GPU, or no driver)");
   if (device < 0 || device >= count)
-    throw InternalError("--device " + std::to_string(device) + ": there are " +
-                        std::to_string(count) + " CUDA device(s), numbered from 0");
+    throw InternalError("there is no CUDA device " + std::to_string(device) + " (" +
+                        std::to_string(count) + " here, numbered from 0)");
   if (const std::string problem = cuda_device_problem(device); !problem.empty())
     throw InternalError(problem);
   return std::make_unique<CudaBackendImpl>(device);

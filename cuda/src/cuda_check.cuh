@@ -1,5 +1,6 @@
-// Every CUDA call is checked: a failure throws snag::InternalError with the file, the line, the
-// call and CUDA's own message (cli/main.cpp turns it into exit status 4). Nothing here exits.
+// Every CUDA call is checked: a failure throws snag::InternalError (snag::OutOfMemory when memory
+// ran out) with the file, the line, the call and CUDA's own message (cli/main.cpp turns it into
+// exit status 4). Nothing here exits.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -11,27 +12,48 @@
 
 namespace snag::cuda {
 
+/// The current device's free and total memory in words ("F MiB of T MiB free"), or empty
+/// when the device cannot say.
+inline std::string free_device_memory_text() {
+  size_t free = 0, total = 0;
+  if (cudaMemGetInfo(&free, &total) != cudaSuccess) {
+    cudaGetLastError();
+    return {};
+  }
+  const auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+  return mib(free) + " of " + mib(total) + " free";
+}
+
+/// A failed call: snag::OutOfMemory when the device ran out of memory (an allocation, or a
+/// stream, event or context that needed some), with what was free; else snag::InternalError.
 [[noreturn]] inline void throw_cuda_error(cudaError_t status, const char* what, const char* file,
                                           int line) {
-  throw InternalError(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
-                      cudaGetErrorName(status) + ": " + cudaGetErrorString(status));
+  const std::string call = std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
+                           cudaGetErrorName(status) + ": " + cudaGetErrorString(status);
+  if (status == cudaErrorMemoryAllocation) {
+    cudaGetLastError();  // not sticky: the device stays usable
+    const std::string free = free_device_memory_text();
+    throw OutOfMemory("the GPU ran out of memory (" + call + (free.empty() ? "" : "; " + free) +
+                      ")");
+  }
+  throw InternalError(call);
 }
 
 /// A device allocation that did not fit: how much was asked for and how much is free, in
 /// words a user can act on (a frame with millions of candidate pairs, on a GPU that is small or
 /// shared with another job). The command line adds what to do.
 [[noreturn]] inline void throw_out_of_device_memory(size_t bytes) {
-  size_t free = 0, total = 0;
-  if (cudaMemGetInfo(&free, &total) != cudaSuccess) cudaGetLastError();
   const auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
-  std::string message = "the GPU's memory is too small for this frame: a buffer of ";
-  message += mib(bytes);
-  message += " did not fit (";
-  message += mib(free);
-  message += " of ";
-  message += mib(total);
-  message += " free)";
-  throw OutOfDeviceMemory(message);
+  const std::string free = free_device_memory_text();
+  throw OutOfMemory("the GPU's memory is too small for this frame: a buffer of " + mib(bytes) +
+                    " did not fit" + (free.empty() ? "" : " (" + free + ")"));
+}
+
+/// Page-locked host memory that could not be had (the host's memory, or its limit on locked
+/// memory, `ulimit -l`, in a container).
+[[noreturn]] inline void throw_out_of_pinned_memory(size_t bytes) {
+  throw OutOfMemory("the host could not lock " + std::to_string((bytes + (1u << 20) - 1) >> 20) +
+                    " MiB of memory for transfers to the GPU (cudaMallocHost)");
 }
 
 }  // namespace snag::cuda

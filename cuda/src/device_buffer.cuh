@@ -69,7 +69,14 @@ class PinnedBuffer {
   void reserve(size_t count) {
     if (count <= capacity_) return;
     release();
-    SNAG_CUDA_CHECK(cudaMallocHost(&data_, count * sizeof(T)));
+    const cudaError_t status = cudaMallocHost(&data_, count * sizeof(T));
+    if (status == cudaErrorMemoryAllocation) {
+      cudaGetLastError();
+      data_ = nullptr;
+      throw_out_of_pinned_memory(count * sizeof(T));
+    }
+    if (status != cudaSuccess)
+      throw_cuda_error(status, "cudaMallocHost(&data_, count * sizeof(T))", __FILE__, __LINE__);
     capacity_ = count;
   }
   T* data() const { return data_; }

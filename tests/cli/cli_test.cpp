@@ -335,8 +335,7 @@ TEST(CliCheck, KilledRunLeavesNoTemporaries) {
 
 // The hand-built sequence's topology changes at frame 2: the progress line says so, and the
 // summary counts builds, rebuilds and topology changes in words that agree in number; under
-// --rebuild always every frame is rebuilt (frames.csv's `rebuilt`), where auto leaves frame 3's
-// refit tree alone.
+// --rebuild always every frame is rebuilt (frames.csv's `rebuilt`).
 TEST(CliCheck, ProgressAndSummaryCountTopologyChangesAndRebuilds) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");
@@ -366,10 +365,13 @@ TEST(CliCheck, ProgressAndSummaryCountTopologyChangesAndRebuilds) {
 TEST(CliCheck, ReportSettingsGiveTheThreadsAndFramesThatRan) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");
-  ASSERT_EQ(::setenv("OMP_NUM_THREADS", "3", 1), 0);
-  const RunResult zero =
-      run_snag({"check", "seq", "--frames", "1-3x2", "--threads", "0", "--out", "z"}, tmp.path());
-  ::unsetenv("OMP_NUM_THREADS");
+  RunResult zero;
+  {
+    const ScopedEnv threads("OMP_NUM_THREADS", "3");
+    const ScopedEnv limit("OMP_THREAD_LIMIT", nullptr);  // a limit under 3 would cap the count
+    zero =
+        run_snag({"check", "seq", "--frames", "1-3x2", "--threads", "0", "--out", "z"}, tmp.path());
+  }
   ASSERT_EQ(zero.status, 1) << context(zero);
   const auto z = nlohmann::json::parse(read_text(tmp.path() / "z" / "report.json"));
   EXPECT_EQ(z.at("settings").at("threads"), 3) << "--threads 0: every core (OMP_NUM_THREADS)";
@@ -434,6 +436,7 @@ TEST(CliCheck, AnIgnoredInterruptStaysIgnored) {
   ASSERT_GE(child, 0);
   if (child == 0) {
     ::signal(SIGINT, SIG_IGN);
+    ::signal(SIGTERM, SIG_DFL);  // the test ends the run with it
     if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
     ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
             "--fail-on", "none", "--out", "out", static_cast<char*>(nullptr));
@@ -453,15 +456,21 @@ TEST(CliCheck, AnIgnoredInterruptStaysIgnored) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_EQ(ended, 0) << "the run ended before it was under way, status " << status;
+  if (!started()) {
+    ::kill(child, SIGKILL);
+    ::waitpid(child, &status, 0);
+    FAIL() << "the run's report temporaries did not appear within 30 s";
+  }
   ::kill(child, SIGINT);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   ended = ::waitpid(child, &status, WNOHANG);
+  // Still going (then ended here), or finished its frames as if nothing had come.
+  EXPECT_TRUE(ended == 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 0))
+      << "the run ended after an ignored SIGINT, status " << status;
   if (ended == 0) {
     ::kill(child, SIGTERM);
     ::waitpid(child, &status, 0);
   }
-  EXPECT_FALSE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT)
-      << "an ignored SIGINT ended the run";
 }
 
 TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
@@ -629,12 +638,14 @@ TEST(CliStatus, VersionSaysWhatTheCudaBackendWasBuiltFor) {
   const RunResult r = run_snag({"--version"}, tmp.path());
   ASSERT_EQ(r.status, 0) << context(r);
   EXPECT_EQ(r.out.rfind("snag ", 0), 0u) << r.out;
-  const size_t line = r.out.find("\nCUDA backend: ");
-  ASSERT_NE(line, std::string::npos) << r.out;
-  const std::string rest = r.out.substr(line);
-  EXPECT_TRUE(rest.find("architectures ") != std::string::npos ||
-              rest.find("not built") != std::string::npos)
+#ifdef SNAG_EXPECTED_CUDA_ARCHITECTURES
+  EXPECT_NE(r.out.find(std::string("\nCUDA backend: architectures ") +
+                       SNAG_EXPECTED_CUDA_ARCHITECTURES + "; CUDA runtime "),
+            std::string::npos)
       << r.out;
+#else
+  EXPECT_NE(r.out.find("\nCUDA backend: not built ("), std::string::npos) << r.out;
+#endif
 }
 
 TEST(CliStatus, MalformedObjExitsThreeAndLeavesNoReport) {

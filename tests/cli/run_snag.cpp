@@ -57,18 +57,26 @@ RunResult run_snag(const std::vector<std::string>& args, const fs::path& cwd) {
   return r;
 }
 
+ScopedEnv::ScopedEnv(const char* name, const char* value) : name_(name) {
+  if (const char* was = std::getenv(name)) previous_ = was;
+  if (value)
+    ::setenv(name, value, 1);
+  else
+    ::unsetenv(name);
+}
+
+ScopedEnv::~ScopedEnv() {
+  if (previous_)
+    ::setenv(name_.c_str(), previous_->c_str(), 1);
+  else
+    ::unsetenv(name_.c_str());
+}
+
 RunResult run_snag_without_data(const std::vector<std::string>& args, const fs::path& cwd) {
   const fs::path no_data = cwd / "no-data";
   fs::create_directories(no_data);
-  const char* was = std::getenv("SNAG_DATA_DIR");
-  const std::optional<std::string> previous = was ? std::optional<std::string>(was) : std::nullopt;
-  ::setenv("SNAG_DATA_DIR", no_data.c_str(), 1);
-  RunResult r = run_snag(args, cwd);
-  if (previous)
-    ::setenv("SNAG_DATA_DIR", previous->c_str(), 1);
-  else
-    ::unsetenv("SNAG_DATA_DIR");
-  return r;
+  const ScopedEnv data("SNAG_DATA_DIR", no_data.c_str());
+  return run_snag(args, cwd);
 }
 
 std::vector<std::string> table_row(const std::string& text, const std::string& prefix, int nth) {

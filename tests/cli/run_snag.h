@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,20 @@ RunResult run_snag(const std::vector<std::string>& args, const std::filesystem::
 /// shared-data cases; $SNAG_DATA_DIR is as it was afterwards.
 RunResult run_snag_without_data(const std::vector<std::string>& args,
                                 const std::filesystem::path& cwd);
+
+/// Sets (or, with nullptr, unsets) an environment variable for its lifetime, then puts back what
+/// was there, also when a test fails or throws in between.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value);
+  ~ScopedEnv();
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> previous_;
+};
 
 /// The whitespace-separated words after `prefix` of the `nth` line (from 0) of `text` that
 /// starts with it (a row of a bench table); a test failure and no words when there is none.

@@ -1,5 +1,5 @@
 // DeviceBuffer (cuda/src/device_buffer.cuh): an allocation past the GPU's memory is an
-// OutOfDeviceMemory saying how much did not fit and how much was free, and leaves no CUDA error
+// OutOfMemory saying how much did not fit and how much was free, and leaves no CUDA error
 // pending for the next call. Without a GPU the test skips with a loud message.
 #include <gtest/gtest.h>
 
@@ -13,14 +13,14 @@
 namespace snag::test {
 namespace {
 
-TEST(CudaDeviceBuffer, AllocationPastTheDevicesMemoryIsOutOfDeviceMemory) {
+TEST(CudaDeviceBuffer, AllocationPastTheDevicesMemoryIsOutOfMemory) {
   SNAG_REQUIRE_GPU();
   cuda::DeviceBuffer<uint8_t> buffer;
   buffer.reserve(16);
   try {
     buffer.reserve(size_t{1} << 50);  // a pebibyte: more than any GPU holds
     FAIL() << "a pebibyte was allocated";
-  } catch (const OutOfDeviceMemory& e) {
+  } catch (const OutOfMemory& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("1073741824 MiB did not fit"), std::string::npos) << message;
     EXPECT_NE(message.find(" free)"), std::string::npos) << message;

@@ -62,9 +62,10 @@ for step in "${steps[@]}"; do
           --gtest_filter="$filter" >"$out/sanitize_$tool.log" 2>&1; rc=$?
         summary+=("$tool         rc=$rc $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/sanitize_$tool.log" | tail -1) $(grep -E '^\[  (PASSED|FAILED) ' "$out/sanitize_$tool.log" | tr '\n' ' ')")
       done
-      compute-sanitizer --tool memcheck --report-api-errors no --error-exitcode 97 snag_cuda_tests \
-        --gtest_brief=1 --gtest_filter='CudaDeviceBuffer.*' >"$out/sanitize_memcheck_oom.log" 2>&1; rc=$?
-      summary+=("memcheck (OOM)   rc=$rc $(grep -E 'ERROR SUMMARY' "$out/sanitize_memcheck_oom.log" | tail -1)")
+      timeout ${SANITIZE_TIMEOUT:-400} compute-sanitizer --tool memcheck --report-api-errors no \
+        --error-exitcode 97 snag_cuda_tests --gtest_brief=1 --gtest_filter='CudaDeviceBuffer.*' \
+        >"$out/sanitize_memcheck_oom.log" 2>&1; rc=$?
+      summary+=("memcheck (OOM)   rc=$rc $(grep -E 'ERROR SUMMARY' "$out/sanitize_memcheck_oom.log" | tail -1) $(grep -E '^\[  (PASSED|FAILED) ' "$out/sanitize_memcheck_oom.log" | tr '\n' ' ')")
       ;;
     reports)
       # Every sample and shared-data file checked on both backends: the reports must agree.

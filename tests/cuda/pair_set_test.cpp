@@ -107,7 +107,7 @@ Expansion expand(const Book& book, const std::vector<uint64_t>& hits,
   if (state == cudaErrorNotReady) {
     std::fprintf(stderr,
                  "FAILED: the expansion into a full pair set is still running after 20 s (its "
-                 "probe does not end); stopping the test binary\n");
+                 "probe does not end); stopping the test binary, whose later tests do not run\n");
     std::fflush(stderr);
     std::_Exit(1);
   }

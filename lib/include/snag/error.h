@@ -48,11 +48,12 @@ class InternalError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// A GPU whose free memory cannot hold a frame's buffers (exit status 4, as a failing device
-/// call, but no fault of snag's: a frame with millions of candidate pairs, a small GPU or one
-/// shared with another job). The message says how much did not fit and how much was free; what
-/// to do about it is the caller's to say.
-class OutOfDeviceMemory : public InternalError {
+/// Memory for a frame's buffers ran out where snag cannot choose less: on the GPU (a frame with
+/// millions of candidate pairs, a small GPU or one shared with another job), or the host memory
+/// locked for transfers to it. Exit status 4, as a failing device call, but no fault of snag's;
+/// the message says what did not fit and, for the GPU, how much was free; what to do about it is
+/// the caller's to say.
+class OutOfMemory : public InternalError {
  public:
   using InternalError::InternalError;
 };
