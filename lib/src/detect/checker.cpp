@@ -30,7 +30,7 @@ Checker::Checker(std::unique_ptr<Backend> backend, std::shared_ptr<ExactResolver
   if (settings_.exact == ExactMode::off) resolver_ = make_rounded_resolver();
   if (!backend_ || !resolver_) throw InternalError("Checker needs a backend and an exact resolver");
   if (settings_.exact == ExactMode::all && !confirmer_)
-    throw InternalError("--exact all needs a pair confirmer");
+    throw InternalError("Checker: ExactMode::all needs a pair confirmer");
 }
 
 Checker::~Checker() = default;
