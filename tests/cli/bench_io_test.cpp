@@ -45,7 +45,9 @@ TEST(CliBench, IoReadsEveryFormatAndChecksTheSequence) {
     EXPECT_GE(std::stod(loop[i]), 0) << i;
     shares += std::stod(loop[i]);
   }
-  EXPECT_GT(std::stod(loop[2]), 0);               // checking
+  // checking: 8 frames of 800 triangles take ~0.3-1 ms in all, printed with three decimals, so
+  // 0.000 now and then (run outside ctest, without OMP_WAIT_POLICY=passive, more often).
+  EXPECT_GE(std::stod(loop[2]), 0);
   EXPECT_EQ(loop[5], "0.000");                    // behind
   EXPECT_EQ(loop[6], cpu[3]);                     // the loop is snag check's time
   EXPECT_LE(shares, std::stod(loop[6]) + 0.006);  // three decimals each, rounded

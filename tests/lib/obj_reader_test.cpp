@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -16,6 +18,7 @@
 #include <utility>
 
 #include "snag/error.h"
+#include "snag/io/assimp_reader.h"
 #include "snag/io/read_mesh.h"
 #include "test_paths.h"
 
@@ -585,6 +588,45 @@ TEST(ReadMesh, MalformedFilesThroughAssimpAreInputErrorsNotCrashes) {
                   std::string::npos)
             << e.what();
     }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ReadMesh, AFileAssimpMisreadsIsAnInputErrorNotACrash) {
+  // Found by `snag bench io` (assimp as a peer crashed on frame 15 of a generated cloth): a
+  // binary PLY whose data starts with a byte that looks like whitespace (0x0a, the low byte of
+  // its first x) is read by libassimp 5.2 one byte off, with faces of no corners, and its
+  // triangulation then aborted the process (an assertion) or its vertex joining read out of
+  // bounds. Read without steps and checked first, it is an error naming the file. snag's own
+  // reader, which reads PLY, gets it right.
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("snag_misread_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::string file =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty "
+      "float y\nproperty float z\nelement face 2\nproperty list uchar int "
+      "vertex_indices\nend_header\n";
+  const auto put = [&](const auto& value) {
+    file.append(reinterpret_cast<const char*>(&value), sizeof value);
+  };
+  uint32_t first_x_bits = 0x3f80000a;  // 1.0000012f, its first byte 0x0a in little-endian order
+  float first_x = 0;
+  std::memcpy(&first_x, &first_x_bits, sizeof first_x);
+  for (const float v : {first_x, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 1.f, 1.f, 1.f}) put(v);
+  for (const std::array<int32_t, 3> face : {std::array<int32_t, 3>{0, 1, 2}, {1, 2, 3}}) {
+    put(uint8_t{3});
+    for (const int32_t index : face) put(index);
+  }
+  const auto path = dir / "newline_first.ply";
+  std::ofstream(path, std::ios::binary) << file;
+  EXPECT_EQ(read_mesh(path).triangles.size(), 2u);
+  try {
+    read_with_assimp(path);
+    ADD_FAILURE() << "assimp's misreading was taken for a mesh";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("newline_first.ply"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("assimp read the file wrongly"), std::string::npos)
+        << e.what();
   }
   std::filesystem::remove_all(dir);
 }

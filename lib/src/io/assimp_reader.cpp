@@ -108,6 +108,24 @@ void check_off_counts(const std::filesystem::path& path) {
 
 }  // namespace
 
+std::string unsound_assimp_scene(const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr) return "mesh " + std::to_string(m) + " is missing";
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      const std::string which =
+          "face " + std::to_string(f) + " of mesh " + std::to_string(m) + " (assimp's numbering)";
+      if (face.mNumIndices == 0 || face.mIndices == nullptr) return which + " has no corners";
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= mesh->mNumVertices)
+          return which + " has corner " + std::to_string(face.mIndices[k]) + " of " +
+                 std::to_string(mesh->mNumVertices) + " vertices";
+    }
+  }
+  return {};
+}
+
 mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   Assimp::Importer importer;
   // Joining compares every vertex attribute, not only the position: an STL corner carries its
@@ -116,23 +134,32 @@ mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                               aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                   aiComponent_COLORS | aiComponent_TEXCOORDS);
-  unsigned steps =
+  const unsigned steps =
       aiProcess_RemoveComponent | aiProcess_JoinIdenticalVertices | aiProcess_Triangulate;
   std::string extension = path.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  unsigned reading = 0;
   if (extension == ".off") {
     check_off_counts(path);
     // libassimp 5.2's OFF importer hands on a face without indices when a face line is missing
-    // or unreadable, and the steps inside ReadFile then asserted (aborting the process) or read
-    // out of bounds; its validation, which runs first, refuses it. Only for OFF: it checks the
-    // whole scene, and refuses files of other formats whose cameras or lights share a name
-    // (which FBX allows) though their meshes are sound.
-    steps |= aiProcess_ValidateDataStructure;
+    // or unreadable; its validation refuses it. Only for OFF: it checks the whole scene, and
+    // refuses files of other formats whose cameras or lights share a name (which FBX allows)
+    // though their meshes are sound.
+    reading = aiProcess_ValidateDataStructure;
   }
-  const aiScene* scene = importer.ReadFile(path.string(), steps);
+  // Read without the steps, checked, then processed: the steps abort the process (assertions
+  // compiled in) or read out of bounds on a scene with faces that assimp misread.
+  const aiScene* scene = importer.ReadFile(path.string(), reading);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw InputError(path.string(), 0,
                      std::string("assimp cannot read the file: ") + importer.GetErrorString());
+  }
+  if (const std::string unsound = unsound_assimp_scene(*scene); !unsound.empty())
+    throw InputError(path.string(), 0, "assimp read the file wrongly or it is corrupt: " + unsound);
+  scene = importer.ApplyPostProcessing(steps);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw InputError(path.string(), 0,
+                     std::string("assimp cannot process the file: ") + importer.GetErrorString());
   }
   SceneFlattener flat{scene, path.string(), {}};
   flat.add_node(scene->mRootNode, aiMatrix4x4());
