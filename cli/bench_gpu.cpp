@@ -286,9 +286,8 @@ void print_tables(const std::vector<Row>& rows, const std::string& device, int t
       "refit, quality, traverse, classify: each stage on its own; scan: the checker's scan with "
       "the refit, the quality and the last frame's detect queued ahead of their calls (its wait "
       "ends once the host has queued them all);\nframe: scan, refit, quality, detect as the "
-      "checker "
-      "calls them, pairs back "
-      "on the host (dev: positions on the device; host: uploaded from host memory first)\n\n");
+      "checker calls them, pairs back on the host (dev: positions on the device; host: uploaded "
+      "from host memory first)\n\n");
   std::printf("%-14s %8s %6s %8s %7s %7s %7s %8s %8s %8s %8s %9s %9s %8s %8s %5s\n", "case", "tris",
               "timed", "build", "refit", "quality", "scan", "traverse", "classify", "frame",
               "frame", "CPU build", "CPU frame", "CPU/GPU", "pairs", "same");

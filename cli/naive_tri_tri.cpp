@@ -43,7 +43,8 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d) {
 
 bool inside(Point2 p, Point2 a, Point2 b, Point2 c) {
   const double s1 = orient(a, b, p), s2 = orient(b, c, p), s3 = orient(c, a, p);
-  const bool negative = s1 < 0 || s2 < 0 || s3<0, positive = s1> 0 || s2 > 0 || s3 > 0;
+  const bool negative = s1 < 0 || s2 < 0 || s3 < 0;
+  const bool positive = s1 > 0 || s2 > 0 || s3 > 0;
   return !(negative && positive);
 }
 
