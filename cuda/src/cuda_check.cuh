@@ -12,6 +12,11 @@
 
 namespace snag::cuda {
 
+/// `bytes` in whole MiB, rounded up ("3 MiB").
+inline std::string mib_text(size_t bytes) {
+  return std::to_string((bytes + (size_t{1} << 20) - 1) >> 20) + " MiB";
+}
+
 /// The current device's free and total memory in words ("F MiB of T MiB free"), or empty
 /// when the device cannot say.
 inline std::string free_device_memory_text() {
@@ -20,8 +25,7 @@ inline std::string free_device_memory_text() {
     cudaGetLastError();
     return {};
   }
-  const auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
-  return mib(free) + " of " + mib(total) + " free";
+  return mib_text(free) + " of " + mib_text(total) + " free";
 }
 
 /// A failed call: snag::OutOfMemory when the device ran out of memory (an allocation, or a
@@ -43,17 +47,32 @@ inline std::string free_device_memory_text() {
 /// words a user can act on (a frame with millions of candidate pairs, on a GPU that is small or
 /// shared with another job). The command line adds what to do.
 [[noreturn]] inline void throw_out_of_device_memory(size_t bytes) {
-  const auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
   const std::string free = free_device_memory_text();
-  throw OutOfMemory("the GPU's memory is too small for this frame: a buffer of " + mib(bytes) +
-                    " did not fit" + (free.empty() ? "" : " (" + free + ")"));
+  throw OutOfMemory("the GPU's memory is too small for this frame: a buffer of " +
+                    mib_text(bytes) + " did not fit" + (free.empty() ? "" : " (" + free + ")"));
 }
 
 /// Page-locked host memory that could not be had (the host's memory, or its limit on locked
 /// memory, `ulimit -l`, in a container).
 [[noreturn]] inline void throw_out_of_pinned_memory(size_t bytes) {
-  throw OutOfMemory("the host could not lock " + std::to_string((bytes + (1u << 20) - 1) >> 20) +
-                    " MiB of memory for transfers to the GPU (cudaMallocHost)");
+  throw OutOfMemory("the host could not lock " + mib_text(bytes) +
+                    " of memory for transfers to the GPU (cudaMallocHost)");
+}
+
+/// Where an allocation was asked for, which says what its running out means to a user.
+enum class MemoryKind { device, pinned_host };
+
+/// A failed allocation of `bytes` (`status` is not cudaSuccess): when memory ran out, the
+/// OutOfMemory of its kind (throw_out_of_device_memory, throw_out_of_pinned_memory), else
+/// throw_cuda_error's.
+[[noreturn]] inline void throw_allocation_error(cudaError_t status, MemoryKind kind, size_t bytes,
+                                                const char* what, const char* file, int line) {
+  if (status == cudaErrorMemoryAllocation) {
+    cudaGetLastError();  // not sticky: the device stays usable
+    if (kind == MemoryKind::device) throw_out_of_device_memory(bytes);
+    throw_out_of_pinned_memory(bytes);
+  }
+  throw_cuda_error(status, what, file, line);
 }
 
 }  // namespace snag::cuda

@@ -30,14 +30,11 @@ class DeviceBuffer {
   void reserve(size_t count) {
     if (count <= capacity_) return;
     release();
-    const cudaError_t status = cudaMalloc(&data_, count * sizeof(T));
-    if (status == cudaErrorMemoryAllocation) {
-      cudaGetLastError();
-      data_ = nullptr;
-      throw_out_of_device_memory(count * sizeof(T));
+    if (const cudaError_t status = cudaMalloc(&data_, count * sizeof(T)); status != cudaSuccess) {
+      data_ = nullptr;  // release() must not free what the failed call left there
+      throw_allocation_error(status, MemoryKind::device, count * sizeof(T),
+                             "cudaMalloc(&data_, count * sizeof(T))", __FILE__, __LINE__);
     }
-    if (status != cudaSuccess)
-      throw_cuda_error(status, "cudaMalloc(&data_, count * sizeof(T))", __FILE__, __LINE__);
     capacity_ = count;
   }
   void swap(DeviceBuffer& other) noexcept {
@@ -69,14 +66,12 @@ class PinnedBuffer {
   void reserve(size_t count) {
     if (count <= capacity_) return;
     release();
-    const cudaError_t status = cudaMallocHost(&data_, count * sizeof(T));
-    if (status == cudaErrorMemoryAllocation) {
-      cudaGetLastError();
-      data_ = nullptr;
-      throw_out_of_pinned_memory(count * sizeof(T));
+    if (const cudaError_t status = cudaMallocHost(&data_, count * sizeof(T));
+        status != cudaSuccess) {
+      data_ = nullptr;  // release() must not free what the failed call left there
+      throw_allocation_error(status, MemoryKind::pinned_host, count * sizeof(T),
+                             "cudaMallocHost(&data_, count * sizeof(T))", __FILE__, __LINE__);
     }
-    if (status != cudaSuccess)
-      throw_cuda_error(status, "cudaMallocHost(&data_, count * sizeof(T))", __FILE__, __LINE__);
     capacity_ = count;
   }
   T* data() const { return data_; }
