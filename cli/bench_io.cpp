@@ -206,15 +206,10 @@ std::vector<Reader> readers() {
                       // checked, then triangulated, as snag's path does: libassimp 5.2 misreads
                       // some binary PLY files, and triangulating those aborts the process.
                       Assimp::Importer importer;
-                      const aiScene* scene = importer.ReadFile(f.string(), 0);
-                      if (!scene) throw InputError(f.string(), 0, importer.GetErrorString());
-                      if (const std::string unsound = io::unsound_assimp_scene(*scene);
-                          !unsound.empty())
-                        throw InputError(f.string(), 0, unsound);
-                      scene = importer.ApplyPostProcessing(aiProcess_Triangulate);
-                      if (!scene) throw InputError(f.string(), 0, importer.GetErrorString());
-                      for (unsigned i = 0; i < scene->mNumMeshes; ++i)
-                        sum += scene->mMeshes[i]->mNumVertices;
+                      const aiScene& scene =
+                          io::import_checked(importer, f, 0, aiProcess_Triangulate);
+                      for (unsigned i = 0; i < scene.mNumMeshes; ++i)
+                        sum += scene.mMeshes[i]->mNumVertices;
                     }
                     return sum;
                   }});

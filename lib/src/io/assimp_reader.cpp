@@ -106,8 +106,8 @@ void check_off_counts(const std::filesystem::path& path) {
                          ", more than its " + std::to_string(size) + " bytes can hold");
 }
 
-}  // namespace
-
+/// Why assimp's scene as read (before its post-processing steps) is not sound, or empty when it
+/// is: a face without corners, or a corner past its mesh's vertices.
 std::string unsound_assimp_scene(const aiScene& scene) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh* mesh = scene.mMeshes[m];
@@ -124,6 +124,25 @@ std::string unsound_assimp_scene(const aiScene& scene) {
     }
   }
   return {};
+}
+
+}  // namespace
+
+const aiScene& import_checked(Assimp::Importer& importer, const std::filesystem::path& path,
+                              unsigned reading, unsigned steps) {
+  const aiScene* scene = importer.ReadFile(path.string(), reading);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw InputError(path.string(), 0,
+                     std::string("assimp cannot read the file: ") + importer.GetErrorString());
+  }
+  if (const std::string unsound = unsound_assimp_scene(*scene); !unsound.empty())
+    throw InputError(path.string(), 0, "assimp read the file wrongly or it is corrupt: " + unsound);
+  scene = importer.ApplyPostProcessing(steps);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw InputError(path.string(), 0,
+                     std::string("assimp cannot process the file: ") + importer.GetErrorString());
+  }
+  return *scene;
 }
 
 mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
@@ -147,22 +166,9 @@ mesh::Mesh read_with_assimp(const std::filesystem::path& path) {
     // though their meshes are sound.
     reading = aiProcess_ValidateDataStructure;
   }
-  // Read without the steps, checked, then processed: the steps abort the process (assertions
-  // compiled in) or read out of bounds on a scene with faces that assimp misread.
-  const aiScene* scene = importer.ReadFile(path.string(), reading);
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw InputError(path.string(), 0,
-                     std::string("assimp cannot read the file: ") + importer.GetErrorString());
-  }
-  if (const std::string unsound = unsound_assimp_scene(*scene); !unsound.empty())
-    throw InputError(path.string(), 0, "assimp read the file wrongly or it is corrupt: " + unsound);
-  scene = importer.ApplyPostProcessing(steps);
-  if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw InputError(path.string(), 0,
-                     std::string("assimp cannot process the file: ") + importer.GetErrorString());
-  }
-  SceneFlattener flat{scene, path.string(), {}};
-  flat.add_node(scene->mRootNode, aiMatrix4x4());
+  const aiScene& scene = import_checked(importer, path, reading, steps);
+  SceneFlattener flat{&scene, path.string(), {}};
+  flat.add_node(scene.mRootNode, aiMatrix4x4());
   flat.out.polygon_count = static_cast<int64_t>(flat.out.triangles.size());
   flat.out.ids_from_assimp = true;
   return std::move(flat.out);

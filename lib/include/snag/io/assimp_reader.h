@@ -7,6 +7,9 @@
 #include "snag/mesh/mesh.h"
 
 struct aiScene;
+namespace Assimp {
+class Importer;
+}
 
 namespace snag::io {
 
@@ -18,11 +21,14 @@ namespace snag::io {
 /// message.
 mesh::Mesh read_with_assimp(const std::filesystem::path& path);
 
-/// Why assimp's scene as read (before its post-processing steps) is not sound, or empty when it
-/// is: a face without corners, or a corner past its mesh's vertices. libassimp 5.2 reads some
-/// valid files wrongly (a binary PLY whose data starts with a byte that looks like whitespace is
-/// read one byte off: faces without corners), and its post-processing steps then abort the
-/// process or read out of bounds; so a scene is read without steps, checked, then processed.
-std::string unsound_assimp_scene(const aiScene& scene);
+/// Reads `path` with `importer` and only the steps `reading` (validation, say), checks every
+/// face of the scene (at least one corner, each within its mesh's vertices), then applies the
+/// post-processing `steps`; the scene lives as long as the importer. libassimp 5.2 reads some
+/// valid files wrongly (a binary PLY whose data starts with a byte that looks like whitespace
+/// is read one byte off: faces without corners), and its post-processing steps then abort the
+/// process or read out of bounds: checked first, such a scene is a snag::InputError naming the
+/// file, as is one assimp cannot read or process.
+const aiScene& import_checked(Assimp::Importer& importer, const std::filesystem::path& path,
+                              unsigned reading, unsigned steps);
 
 }  // namespace snag::io
