@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <regex>
 #include <set>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -276,60 +278,83 @@ TEST(CliCheck, FramesOfOnlyZeroAreaTrianglesAreNamed) {
   EXPECT_NE(scene.err.find("3 more frames have"), std::string::npos) << scene.err;
 }
 
-// Ctrl-C or a farm's kill midway: the run ends by that signal, and its output directory holds
-// no report temporary (only finished reports would be there, and there are none yet).
-TEST(CliCheck, KilledRunLeavesNoTemporaries) {
-  TempDir tmp;
-  fs::create_directories(tmp.path() / "seq");
-  // 3,000 frames (the drape sample's 12 over and over), so that the run is still going when
-  // its temporaries have appeared.
+/// 3,000 frames in `dir` (the drape sample's 12 over and over, as links): a run long enough to
+/// still be going when its report temporaries have appeared.
+void link_long_drape_sequence(const fs::path& dir) {
+  fs::create_directories(dir);
   const fs::path drape = source_dir() / "samples" / "drape";
   for (int f = 1; f <= 3000; ++f) {
     char name[32], sample[32];
     std::snprintf(name, sizeof name, "f.%04d.obj", f);
     std::snprintf(sample, sizeof sample, "drape.%04d.obj", (f - 1) % 12 + 1);
-    fs::create_symlink(drape / sample, tmp.path() / "seq" / name);
+    fs::create_symlink(drape / sample, dir / name);
   }
+}
+
+/// The report temporaries in `out` (".tmp-" in their names), each followed by a space.
+std::string report_temporaries(const fs::path& out) {
+  std::string names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(out, ec))
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos)
+      names += entry.path().filename().string() + " ";
+  return names;
+}
+
+/// `snag check seq --backend cpu -q --fail-on none --out OUT` started in `cwd` in a child
+/// process, with the given signals' dispositions set there first.
+pid_t start_long_check(const fs::path& cwd, const fs::path& out,
+                       std::initializer_list<std::pair<int, sighandler_t>> dispositions) {
   const std::string executable = snag_executable().string();
+  const pid_t child = ::fork();
+  if (child != 0) return child;
+  for (const auto& [signal_number, handler] : dispositions) ::signal(signal_number, handler);
+  if (::chdir(cwd.c_str()) != 0) ::_exit(127);
+  ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
+          "--fail-on", "none", "--out", out.c_str(), static_cast<char*>(nullptr));
+  ::_exit(127);
+}
+
+/// How a wait for a run's report temporaries ended: `seen` them (they come and go, the output
+/// probe's among them: seen once is enough), or the run `ended` first (its wait `status`); after
+/// 30 s, neither.
+struct TemporariesWait {
+  bool seen = false;
+  pid_t ended = 0;
+  int status = 0;
+};
+TemporariesWait wait_for_temporaries(pid_t child, const fs::path& out) {
+  TemporariesWait w;
+  for (int wait = 0; wait < 30000 && !w.seen && w.ended == 0; ++wait) {
+    w.seen = !report_temporaries(out).empty();
+    if (!w.seen) {
+      w.ended = ::waitpid(child, &w.status, WNOHANG);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  return w;
+}
+
+// Ctrl-C or a farm's kill midway: the run ends by that signal, and its output directory holds
+// no report temporary (only finished reports would be there, and there are none yet).
+TEST(CliCheck, KilledRunLeavesNoTemporaries) {
+  TempDir tmp;
+  link_long_drape_sequence(tmp.path() / "seq");
   for (int signal_number : {SIGINT, SIGTERM}) {
     const fs::path out = tmp.path() / ("out" + std::to_string(signal_number));
-    const pid_t child = ::fork();
+    // snag keeps a signal its caller ignores ignored (AnIgnoredInterruptStaysIgnored); a test
+    // runner started in the background or under nohup passes SIGINT on ignored.
+    const pid_t child = start_long_check(tmp.path(), out, {{signal_number, SIG_DFL}});
     ASSERT_GE(child, 0);
-    if (child == 0) {
-      // snag keeps a signal its caller ignores ignored (AnIgnoredInterruptStaysIgnored); a test
-      // runner started in the background or under nohup passes SIGINT on ignored.
-      ::signal(signal_number, SIG_DFL);
-      if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
-      ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
-              "--fail-on", "none", "--out", out.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    const auto temporaries = [&] {
-      std::string names;
-      std::error_code ec;
-      for (const auto& entry : fs::directory_iterator(out, ec))
-        if (entry.path().filename().string().find(".tmp-") != std::string::npos)
-          names += entry.path().filename().string() + " ";
-      return names;
-    };
-    bool seen = false;
-    int status = 0;
-    pid_t ended = 0;
-    for (int wait = 0; wait < 30000 && !seen && ended == 0; ++wait) {
-      seen = !temporaries().empty();
-      if (!seen) {
-        ended = ::waitpid(child, &status, WNOHANG);
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      }
-    }
-    if (ended == 0) {
+    TemporariesWait w = wait_for_temporaries(child, out);
+    if (w.ended == 0) {
       ::kill(child, signal_number);
-      ::waitpid(child, &status, 0);
+      ::waitpid(child, &w.status, 0);
     }
-    EXPECT_TRUE(seen) << "the run ended before its temporaries were seen";
-    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number)
-        << "signal " << signal_number << ", status " << status;
-    EXPECT_EQ(temporaries(), "") << "signal " << signal_number;
+    EXPECT_TRUE(w.seen) << "the run ended before its temporaries were seen";
+    EXPECT_TRUE(WIFSIGNALED(w.status) && WTERMSIG(w.status) == signal_number)
+        << "signal " << signal_number << ", status " << w.status;
+    EXPECT_EQ(report_temporaries(out), "") << "signal " << signal_number;
   }
 }
 
@@ -423,51 +448,23 @@ TEST(CliCheck, LaterTopologiesWarnOfEmptyFramesButNotAgainOfSeams) {
 // is ended here by SIGTERM, or ends by itself), never by the interrupt.
 TEST(CliCheck, AnIgnoredInterruptStaysIgnored) {
   TempDir tmp;
-  fs::create_directories(tmp.path() / "seq");
-  const fs::path drape = source_dir() / "samples" / "drape";
-  for (int f = 1; f <= 3000; ++f) {
-    char name[32], sample[32];
-    std::snprintf(name, sizeof name, "f.%04d.obj", f);
-    std::snprintf(sample, sizeof sample, "drape.%04d.obj", (f - 1) % 12 + 1);
-    fs::create_symlink(drape / sample, tmp.path() / "seq" / name);
-  }
-  const std::string executable = snag_executable().string();
-  const pid_t child = ::fork();
+  link_long_drape_sequence(tmp.path() / "seq");
+  const fs::path out = tmp.path() / "out";
+  // SIGTERM at its default: the test ends the run with it.
+  const pid_t child = start_long_check(tmp.path(), out, {{SIGINT, SIG_IGN}, {SIGTERM, SIG_DFL}});
   ASSERT_GE(child, 0);
-  if (child == 0) {
-    ::signal(SIGINT, SIG_IGN);
-    ::signal(SIGTERM, SIG_DFL);  // the test ends the run with it
-    if (::chdir(tmp.path().c_str()) != 0) ::_exit(127);
-    ::execl(executable.c_str(), executable.c_str(), "check", "seq", "--backend", "cpu", "-q",
-            "--fail-on", "none", "--out", "out", static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   // Once the run is under way (its report temporaries are there), interrupt it.
-  const auto started = [&] {
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(tmp.path() / "out", ec))
-      if (entry.path().filename().string().find(".tmp-") != std::string::npos) return true;
-    return false;
-  };
-  int status = 0;
-  pid_t ended = 0;
-  bool seen = false;  // the temporaries come and go (the probe's): seen once is enough
-  for (int wait = 0; wait < 30000 && ended == 0 && !seen; ++wait) {
-    seen = started();
-    if (!seen) {
-      ended = ::waitpid(child, &status, WNOHANG);
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-  }
-  ASSERT_EQ(ended, 0) << "the run ended before it was under way, status " << status;
-  if (!seen) {
+  TemporariesWait w = wait_for_temporaries(child, out);
+  ASSERT_EQ(w.ended, 0) << "the run ended before it was under way, status " << w.status;
+  if (!w.seen) {
     ::kill(child, SIGKILL);
-    ::waitpid(child, &status, 0);
+    ::waitpid(child, &w.status, 0);
     FAIL() << "the run's report temporaries did not appear within 30 s";
   }
   ::kill(child, SIGINT);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  ended = ::waitpid(child, &status, WNOHANG);
+  int status = 0;
+  const pid_t ended = ::waitpid(child, &status, WNOHANG);
   // Still going (then ended here), or finished its frames as if nothing had come.
   EXPECT_TRUE(ended == 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 0))
       << "the run ended after an ignored SIGINT, status " << status;
