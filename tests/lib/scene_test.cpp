@@ -355,6 +355,10 @@ class SceneFile : public ::testing::Test {
     return (dir_ / name).string();
   }
 
+  /// A cloth "dress" of three frames, dress.0001.obj to dress.0003.obj (one triangle each, at
+  /// offsets 1 to 3), checked against `against`.
+  ObjectSpec dress_of_three_frames(std::vector<std::string> against) const;
+
   fs::path dir_;
 };
 
@@ -464,6 +468,15 @@ std::string one_triangle_obj(double offset) {
   return "v " + o + " 0 0\nv 1 " + o + " 0\nv 0 1 " + o + "\nf 1 2 3\n";
 }
 
+ObjectSpec SceneFile::dress_of_three_frames(std::vector<std::string> against) const {
+  for (int f = 1; f <= 3; ++f) write("dress.000" + std::to_string(f) + ".obj", one_triangle_obj(f));
+  ObjectSpec dress;
+  dress.name = "dress";
+  dress.sequence = (dir_ / "dress.%04d.obj").string();
+  dress.against = std::move(against);
+  return dress;
+}
+
 std::vector<int64_t> numbers_of(const std::vector<seq::Frame>& frames) {
   std::vector<int64_t> numbers;
   for (const seq::Frame& f : frames) numbers.push_back(f.number);
@@ -471,18 +484,13 @@ std::vector<int64_t> numbers_of(const std::vector<seq::Frame>& frames) {
 }
 
 TEST_F(SceneFile, TheFirstClothSetsTheFramesEvenWhenAnObstacleIsListedFirst) {
-  for (int f = 1; f <= 3; ++f) write("dress.000" + std::to_string(f) + ".obj", one_triangle_obj(f));
-  const std::string body = write("body.obj", one_triangle_obj(5));
+  const ObjectSpec cloth = dress_of_three_frames({"body"});
   Scene scene;
   ObjectSpec obstacle;
   obstacle.name = "body";
-  obstacle.sequence = body;
+  obstacle.sequence = write("body.obj", one_triangle_obj(5));
   obstacle.role = Role::obstacle;
   obstacle.self = false;
-  ObjectSpec cloth;
-  cloth.name = "dress";
-  cloth.sequence = (dir_ / "dress.%04d.obj").string();
-  cloth.against = {"body"};
   scene.objects = {obstacle, cloth};
   const ResolvedScene resolved = resolve_scene(scene, "");
   EXPECT_EQ(numbers_of(resolved.frames), (std::vector<int64_t>{1, 2, 3}));
@@ -499,13 +507,9 @@ TEST_F(SceneFile, TheFirstClothSetsTheFramesEvenWhenAnObstacleIsListedFirst) {
 TEST_F(SceneFile, ASecondClothOfOneFileIsStill) {
   // "an object with a single file that is not one of several frames is still", whatever its
   // role: a second cloth of one file is read once and checked in every frame.
-  for (int f = 1; f <= 3; ++f) write("dress.000" + std::to_string(f) + ".obj", one_triangle_obj(f));
+  const ObjectSpec dress = dress_of_three_frames({"patch"});
   const std::string patch = write("patch.obj", one_triangle_obj(7));
   Scene scene;
-  ObjectSpec dress;
-  dress.name = "dress";
-  dress.sequence = (dir_ / "dress.%04d.obj").string();
-  dress.against = {"patch"};
   ObjectSpec second;
   second.name = "patch";
   second.sequence = patch;
