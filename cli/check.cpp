@@ -318,7 +318,8 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->check(kCount)
       ->capture_default_str();
   cmd->add_option("-j,--threads", o.threads,
-                  "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core")
+                  "Threads of the run (from 8 on the CPU, its readers' too); 0 uses every core, "
+                  "or OMP_NUM_THREADS when set")
       ->type_name("N")
       ->check(kThreadCount)
       ->capture_default_str();
