@@ -20,6 +20,7 @@
 #include "snag/detect/checker.h"
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
+#include "snag/report/baseline.h"
 #include "snag/report/report.h"
 #include "snag/report/stream.h"
 #include "snag/report/write.h"
@@ -144,13 +145,15 @@ class CollapsedFrames {
   int64_t frames_ = 0;
 };
 
-std::string frame_note(const report::FrameRecord& r) {
+/// A checked frame's progress note; with a baseline, how many of its pairs the baseline accepts.
+std::string frame_note(const report::FrameRecord& r, bool baseline) {
   std::string note = "frame " + std::to_string(r.frame) + ": ";
   if (r.pairs.empty()) {
     note += "clean";
   } else {
     note += std::to_string(r.crossing_count()) + " crossing, " +
             std::to_string(r.touching_count()) + " touching";
+    if (baseline) note += " (" + std::to_string(r.accepted_count()) + " accepted)";
   }
   if (!r.degenerate.empty()) note += ", " + std::to_string(r.degenerate.size()) + " degenerate";
   if (r.topology_changed) note += " (topology changed)";
@@ -196,9 +199,10 @@ std::string objects_line(const std::vector<report::ObjectInput>& objects, bool r
   return line;
 }
 
+/// `baseline_file`: --baseline as given, empty without one (inputs.baseline is then not read).
 void print_summary(std::ostream& out, const report::Summary& s, const RunTotals& totals,
                    const std::string& rebuild_policy, const std::string& out_dir,
-                   const report::Inputs& inputs) {
+                   const report::Inputs& inputs, const std::string& baseline_file) {
   if (inputs.scene())
     out << "objects              " << objects_line(inputs.objects, !out_dir.empty()) << "\n";
   out << "frames checked       " << s.frames_checked << "\n";
@@ -212,6 +216,21 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
   }
   out << "pairs                " << s.pairs << " (" << s.crossing << " crossing, " << s.touching
       << " touching)\n";
+  if (!baseline_file.empty()) {
+    const report::BaselineUse& use = inputs.baseline;
+    out << "baseline             " << baseline_file << ": " << use.checked
+        << (use.checked == 1 ? " entry" : " entries") << " for the frames checked, "
+        << use.unmatched << " matched no pair\n";
+    out << "accepted pairs       " << s.accepted << " (" << s.accepted_crossing << " crossing, "
+        << s.accepted - s.accepted_crossing << " touching)\n";
+    const int64_t new_pairs = s.pairs - s.accepted;
+    const int64_t new_crossing = s.crossing - s.accepted_crossing;
+    out << "new pairs            " << new_pairs;
+    if (new_pairs > 0)
+      out << " (" << new_crossing << " crossing, " << new_pairs - new_crossing << " touching) in "
+          << plural(s.frames_with_new_pairs, "frame") << ", the first frame " << *s.first_new_frame;
+    out << "\n";
+  }
   if (s.degenerate > 0) out << "degenerate faces     " << s.degenerate << "\n";
   if (inputs.scene()) {
     out << "reused pairs         " << s.reused_pairs << " (checks whose objects did not move)\n";
@@ -328,6 +347,12 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("WHAT")
       ->check(CLI::IsMember({"crossing", "any", "none"}))
       ->capture_default_str();
+  cmd->add_option("--baseline", o.baseline,
+                  "Pairs accepted earlier (a pairs.csv, rows cut as wanted; frame * for every "
+                  "frame): reported as accepted, they do not fail the run")
+      ->type_name("FILE")
+      ->check(non_empty("a baseline file"))
+      ->check(not_an_option("a baseline file"));
   cmd->add_option("--exact", o.exact,
                   "How signs are decided: off (the double filter decides all, even where its "
                   "error bound cannot; fast, may be wrong on degenerate input), uncertain (what "
@@ -380,6 +405,11 @@ int run_check(const CheckOptions& o) {
   // once rather than after an hour of checking.
   std::optional<report::OutputDirectory> output_directory;
   if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
+  // So is a baseline that cannot be read, or that names objects this run does not have.
+  std::optional<report::Baseline> baseline;
+  if (!o.baseline.empty())
+    baseline = report::Baseline::read(
+        o.baseline, scene_run ? object_inputs(resolved) : std::vector<report::ObjectInput>{});
 
   // The run's threads are the checker's and its readers' (checker_threads_for).
   const int threads = thread_count(o.threads);
@@ -410,6 +440,7 @@ int run_check(const CheckOptions& o) {
   report_settings.rebuild_threshold = o.rebuild_threshold;
   report_settings.fail_on = *fail_on;
   if (!o.frames.empty()) report_settings.frames = o.frames;
+  if (baseline) report_settings.baseline = o.baseline;
   report::Inputs inputs;
   inputs.sequence = o.scene.empty() ? o.sequence : o.scene;
   if (scene_run) inputs.objects = object_inputs(resolved);
@@ -432,8 +463,10 @@ int run_check(const CheckOptions& o) {
   check_scene(
       resolved, *checker, sequence, scene_run, inputs,
       [&](report::FrameRecord&& record) {
+        if (baseline) baseline->mark(record);
         collapsed.note(record, warn);
-        progress.update(reports.summary().frames_checked + 1, frame_note(record));
+        progress.update(reports.summary().frames_checked + 1,
+                        frame_note(record, baseline.has_value()));
         reports.add(std::move(record));
       },
       warn);
@@ -444,17 +477,20 @@ int run_check(const CheckOptions& o) {
   totals.builds = checker->build_count();
   totals.rebuilds = checker->rebuild_count();
   totals.wall_seconds = seconds_since(started);
+  if (baseline) inputs.baseline = baseline->use();
   // Only now, with every frame read, checked and written, do the report files appear.
   const report::Summary summary =
       reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
   if (output_directory) output_directory->keep();
 
-  print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs);
+  print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs, o.baseline);
   std::cout.flush();
   // A summary that did not reach standard output makes the run's status 3 (cli/main.cpp), not
   // the 1 this line would announce.
   if (summary.failed && !o.quiet && std::cout)
-    std::cerr << "snag: intersections found (--fail-on " << o.fail_on << "): exit status 1\n";
+    std::cerr << "snag: "
+              << (baseline ? "new intersections found, not in the baseline" : "intersections found")
+              << " (--fail-on " << o.fail_on << "): exit status 1\n";
   return summary.failed ? 1 : 0;
 }
 

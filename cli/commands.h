@@ -86,6 +86,7 @@ struct CheckOptions {
   int device = 0;
   int threads = 0;
   std::string fail_on = "crossing";
+  std::string baseline;  ///< --baseline FILE, empty when not given
   std::string exact = "uncertain";
   bool quiet = false;
 };

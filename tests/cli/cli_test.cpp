@@ -502,6 +502,160 @@ TEST(CliCheck, CoincidentVerticesWarnUnlessWelded) {
   EXPECT_DOUBLE_EQ(b.at("settings").at("weld").get<double>(), 1e-6);
 }
 
+// --baseline: pairs an earlier run found, accepted; only the others fail the run.
+
+/// pairs.csv's data rows, each cut to its first six columns (the pair as any run reports it).
+std::vector<std::string> pair_rows(const std::string& pairs_csv) {
+  std::vector<std::string> rows;
+  const auto parsed = parse_csv(pairs_csv);
+  for (size_t i = 1; i < parsed.size(); ++i) {
+    std::string row;
+    for (size_t c = 0; c < 6; ++c) row += (c ? "," : "") + parsed[i].at(c);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(CliBaseline, TheDrapesPairsLessSomeFailOnExactlyThoseLeftOut) {
+  TempDir tmp;
+  const std::string drape = (source_dir() / "samples" / "drape").string();
+  const RunResult first = run_snag({"check", drape, "--out", "first", "-q"}, tmp.path());
+  ASSERT_EQ(first.status, 1) << context(first);
+  const std::string found = read_text(tmp.path() / "first" / "pairs.csv");
+  const std::vector<std::string> rows = pair_rows(found);
+  ASSERT_GT(rows.size(), 1000u);
+
+  // Every pair accepted: the run passes even with --fail-on any, and nothing is new.
+  const RunResult all = run_snag(
+      {"check", drape, "--fail-on", "any", "--baseline", "first/pairs.csv", "--out", "all"},
+      tmp.path());
+  EXPECT_EQ(all.status, 0) << context(all);
+  EXPECT_NE(all.out.find("baseline             first/pairs.csv: " + std::to_string(rows.size()) +
+                         " entries for the frames checked, 0 matched no pair\n"),
+            std::string::npos)
+      << all.out;
+  EXPECT_NE(all.out.find("new pairs            0\n"), std::string::npos) << all.out;
+
+  // Every 97th row left out (the file cut by hand, header kept): those pairs are new, and only
+  // those; the reports still list every pair, the same rows as without a baseline.
+  std::string cut = "frame,face_a,face_b,kind,poly_a,poly_b\n";
+  std::vector<std::string> left_out;
+  int64_t left_out_crossing = 0;
+  std::set<std::string> new_frames;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (i % 97 == 40) {
+      left_out.push_back(rows[i]);
+      left_out_crossing += rows[i].find(",crossing,") != std::string::npos;
+      new_frames.insert(rows[i].substr(0, rows[i].find(',')));
+      continue;
+    }
+    cut += rows[i] + "\n";
+  }
+  write_text(tmp.path() / "cut.csv", cut);
+  const RunResult r =
+      run_snag({"check", drape, "--baseline", "cut.csv", "--out", "second"}, tmp.path());
+  ASSERT_EQ(r.status, left_out_crossing > 0 ? 1 : 0) << context(r);
+  const std::string second = read_text(tmp.path() / "second" / "pairs.csv");
+  EXPECT_EQ(pair_rows(second), rows);
+  const auto parsed = parse_csv(second);
+  ASSERT_EQ(parsed.at(0).back(), "accepted");
+  std::vector<std::string> marked_new;
+  for (size_t i = 1; i < parsed.size(); ++i) {
+    ASSERT_EQ(parsed[i].size(), 7u);
+    if (parsed[i][6] == "0")
+      marked_new.push_back(rows[i - 1]);
+    else
+      EXPECT_EQ(parsed[i][6], "1");
+  }
+  EXPECT_EQ(marked_new, left_out);
+
+  const int64_t new_pairs = static_cast<int64_t>(left_out.size());
+  EXPECT_NE(r.out.find("new pairs            " + std::to_string(new_pairs) + " (" +
+                       std::to_string(left_out_crossing) + " crossing, " +
+                       std::to_string(new_pairs - left_out_crossing) + " touching) in " +
+                       std::to_string(new_frames.size()) + " frames, the first frame " +
+                       left_out.front().substr(0, left_out.front().find(',')) + "\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.err.find("new intersections found, not in the baseline (--fail-on crossing)"),
+            std::string::npos)
+      << r.err;
+  // frames.csv counts each frame's accepted pairs; report.json says what the baseline did.
+  const auto frames = parse_csv(read_text(tmp.path() / "second" / "frames.csv"));
+  ASSERT_EQ(frames.at(0).back(), "accepted");
+  int64_t accepted = 0;
+  for (size_t i = 1; i < frames.size(); ++i) accepted += std::stoll(frames[i].back());
+  EXPECT_EQ(accepted, static_cast<int64_t>(rows.size()) - new_pairs);
+  const auto j = nlohmann::json::parse(read_text(tmp.path() / "second" / "report.json"));
+  EXPECT_EQ(j.at("settings").at("baseline"), "cut.csv");
+  EXPECT_EQ(j.at("inputs").at("baseline").at("entries"), rows.size() - left_out.size());
+  EXPECT_EQ(j.at("inputs").at("baseline").at("unmatched"), 0);
+  EXPECT_EQ(j.at("summary").at("new_pairs"), new_pairs);
+  EXPECT_EQ(j.at("summary").at("new_crossing"), left_out_crossing);
+  EXPECT_EQ(j.at("summary").at("failed"), left_out_crossing > 0);
+}
+
+TEST(CliBaseline, HandWrittenRowsForEveryFrameAndByKind) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  // Frame 1's crossing is (1, 2), frame 2's (0, 2) after the faces are reordered.
+  write_text(tmp.path() / "every.csv", "face_b,face_a,frame\n2,1,*\n");
+  const RunResult every = run_snag({"check", "seq", "--baseline", "every.csv"}, tmp.path());
+  EXPECT_EQ(every.status, 1) << context(every);
+  EXPECT_NE(every.out.find("new pairs            1 (1 crossing, 0 touching) in 1 frame, the "
+                           "first frame 2\n"),
+            std::string::npos)
+      << every.out;
+  EXPECT_NE(every.err.find("[1/3] frame 1: 1 crossing, 0 touching (1 accepted)"), std::string::npos)
+      << every.err;
+
+  write_text(tmp.path() / "both.csv", "frame,face_a,face_b\n1,1,2\n2,0,2\n7,0,1\n");
+  const RunResult both = run_snag({"check", "seq", "--baseline", "both.csv"}, tmp.path());
+  EXPECT_EQ(both.status, 0) << context(both);
+  // Frame 7 is not checked: its entry is not counted among the frames checked.
+  EXPECT_NE(both.out.find("both.csv: 2 entries for the frames checked, 0 matched no pair"),
+            std::string::npos)
+      << both.out;
+
+  // Accepted while it touches, it crosses: new, and its entry matched nothing.
+  write_text(tmp.path() / "touching.csv",
+             "frame,face_a,face_b,kind\n1,1,2,touching\n2,0,2,crossing\n");
+  const RunResult touching = run_snag({"check", "seq", "--baseline", "touching.csv"}, tmp.path());
+  EXPECT_EQ(touching.status, 1) << context(touching);
+  EXPECT_NE(touching.out.find("2 entries for the frames checked, 1 matched no pair"),
+            std::string::npos)
+      << touching.out;
+}
+
+TEST(CliBaseline, ABadBaselineExitsThreeBeforeAnyFrameAndWritesNoReport) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  write_text(tmp.path() / "bad.csv", "frame,face_a,face_b\n1,1,2\n2,0,two\n");
+  const RunResult bad =
+      run_snag({"check", "seq", "--baseline", "bad.csv", "--out", "out"}, tmp.path());
+  EXPECT_EQ(bad.status, 3) << context(bad);
+  EXPECT_NE(bad.err.find("bad.csv:3: face_b: expected a face id (a whole number >= 0), got 'two'"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_EQ(bad.err.find("frame 1"), std::string::npos) << "no frame is checked: " << bad.err;
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
+
+  const RunResult missing = run_snag({"check", "seq", "--baseline", "none.csv"}, tmp.path());
+  EXPECT_EQ(missing.status, 3) << context(missing);
+  EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
+
+  // A scene run's pairs.csv given to a run of one mesh.
+  write_text(tmp.path() / "scene.csv",
+             "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n1,0,0,crossing,0,0,a,b\n");
+  const RunResult scene = run_snag({"check", "seq", "--baseline", "scene.csv"}, tmp.path());
+  EXPECT_EQ(scene.status, 3) << context(scene);
+  EXPECT_NE(scene.err.find("scene.csv:1: object_a and object_b columns, but this run checks one "
+                           "mesh"),
+            std::string::npos)
+      << scene.err;
+  EXPECT_EQ(run_snag({"check", "seq", "--baseline", ""}, tmp.path()).status, 2);
+}
+
 TEST(CliStatus, UsageErrorsExitTwo) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");

@@ -254,6 +254,48 @@ TEST(SceneObstacle, MovingObstacleSequence) {
   EXPECT_EQ(column(run, "reused_pairs"), (std::vector<std::string>{"0", "0", "0"}));
 }
 
+TEST(SceneObstacle, ABaselineNamesEachFacesObject) {
+  TempDir tmp;
+  // As in MovingObstacleSequence: frame 2 has (cloth 0, body 0), frame 3 (cloth 0, body 0) and
+  // (cloth 1, body 0). The baseline accepts the body's face 0 with the cloth's face 1, the
+  // pair written body first; and the cloth's faces 0 and 1 with each other, which never meet.
+  const std::vector<std::vector<P>> posts = {moved(post(0.5), {5, 0, 0}), post(0.5), post(1.5)};
+  for (int f = 1; f <= 3; ++f) {
+    write_text(tmp.path() / ("sheet.000" + std::to_string(f) + ".obj"),
+               obj_text(sheet, sheet_faces));
+    write_text(tmp.path() / ("body.000" + std::to_string(f) + ".obj"),
+               obj_text(posts[f - 1], one_face));
+  }
+  write_text(tmp.path() / "accepted.csv",
+             "object_b,object_a,frame,face_a,face_b\n"
+             "cloth,body,*,0,1\n"
+             "cloth,cloth,3,0,1\n");
+  const SceneRun run = run_in(
+      tmp.path(), {"sheet.%04d.obj", "--obstacle", "body.%04d.obj", "--baseline", "accepted.csv"});
+  ASSERT_EQ(run.result.status, 1) << context(run.result);
+  EXPECT_EQ(run.pairs_csv,
+            "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b,accepted\n"
+            "2,0,0,crossing,0,0,cloth,body,0\n"
+            "3,0,0,crossing,0,0,cloth,body,0\n"
+            "3,1,0,crossing,1,0,cloth,body,1\n");
+  EXPECT_EQ(column(run, "accepted"), (std::vector<std::string>{"0", "0", "1"}));
+  EXPECT_EQ(run.report.at("inputs").at("baseline"),
+            json({{"file", "accepted.csv"}, {"entries", 2}, {"checked", 2}, {"unmatched", 1}}));
+  EXPECT_EQ(run.report.at("summary").at("first_new_frame"), 2);
+
+  // An object the run does not have is named, with the run's objects.
+  write_text(tmp.path() / "other.csv",
+             "frame,face_a,face_b,object_a,object_b\n1,0,0,cloth,floor\n");
+  const SceneRun other = run_in(
+      tmp.path(), {"sheet.%04d.obj", "--obstacle", "body.%04d.obj", "--baseline", "other.csv"});
+  EXPECT_EQ(other.result.status, 3) << context(other.result);
+  EXPECT_NE(other.result.err.find(
+                "other.csv:2: object_b: 'floor' is not an object of this run (cloth, body)"),
+            std::string::npos)
+      << other.result.err;
+  expect_no_report(tmp.path() / "out");
+}
+
 TEST(SceneObstacle, ObstacleSequenceMissingAFrameExitsThree) {
   TempDir tmp;
   for (int f = 1; f <= 3; ++f)

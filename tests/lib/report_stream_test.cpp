@@ -364,6 +364,17 @@ std::vector<FrameRecord> random_frames(uint32_t seed, int count) {
   return frames;
 }
 
+/// Marks pairs accepted as a baseline would: every pair of about half the frames, a random
+/// part of the others' pairs (of both kinds).
+void accept_at_random(std::vector<FrameRecord>& frames, uint32_t seed) {
+  std::mt19937 rng(seed + 2000);
+  const auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); };
+  for (FrameRecord& f : frames) {
+    const bool all = uniform(0, 1) == 0;
+    for (Pair& p : f.pairs) p.accepted = all || uniform(0, 2) == 0;
+  }
+}
+
 /// What a test's stream and the whole-report writers made of the same frames.
 struct StreamedAndWhole {
   Summary streamed;
@@ -482,6 +493,89 @@ TEST(ReportStream, SceneRunMatchesTheWholeReportWriters) {
     write_reports(whole.path(), r);
     for (const char* name : {"pairs.csv", "frames.csv", "report.json"})
       EXPECT_EQ(read_all(whole.path() / name), read_all(tmp.path() / name)) << name;
+  }
+}
+
+TEST(ReportStream, BaselineRunMatchesTheWholeReportWriters) {
+  // A single mesh and a scene, each with a baseline: the accepted columns and members come out
+  // of the stream as the whole-report writers write them, and nowhere without a baseline.
+  for (const bool scene : {false, true}) {
+    SCOPED_TRACE(scene ? "scene" : "single mesh");
+    Settings settings = small_settings();
+    settings.fail_on = FailOn::any;
+    settings.baseline = "ci/accepted, \"v2\".csv";
+    Inputs inputs = small_inputs();
+    if (scene) {
+      // Names without line breaks, so that the rows below can be read line by line (the
+      // other tests cover names that need quoting).
+      inputs.objects = scene_objects();
+      for (size_t i = 0; i < inputs.objects.size(); ++i)
+        inputs.objects[i].name = "object" + std::to_string(i);
+    }
+    inputs.baseline = {120, 90, 7};
+    std::vector<FrameRecord> frames =
+        scene ? random_scene_frames(7, 30, inputs.objects) : random_frames(7, 30);
+    for (FrameRecord& f : frames) f.file = "cache/cloth." + std::to_string(f.frame) + ".obj";
+    accept_at_random(frames, 7);
+    const TempDir tmp;
+    const auto [streamed, r] = expect_streamed_as_whole(tmp.path(), settings, inputs, frames, 2);
+
+    const std::string pairs = read_all(tmp.path() / "pairs.csv");
+    const std::string frames_csv = read_all(tmp.path() / "frames.csv");
+    EXPECT_EQ(pairs.substr(0, pairs.find('\n')),
+              std::string(scene ? scene_pairs_csv_header : pairs_csv_header) + ",accepted");
+    EXPECT_EQ(frames_csv.substr(0, frames_csv.find('\n')),
+              std::string(scene ? scene_frames_csv_header : frames_csv_header) + ",accepted");
+    // Each pair's row ends in its mark, each frame's row in its count, in frame order.
+    std::istringstream pair_rows(pairs.substr(pairs.find('\n') + 1));
+    std::istringstream frame_rows(frames_csv.substr(frames_csv.find('\n') + 1));
+    std::string row;
+    int64_t rows_accepted = 0, rows = 0;
+    while (std::getline(pair_rows, row)) {
+      ASSERT_TRUE(row.ends_with(",0") || row.ends_with(",1")) << row;
+      rows_accepted += row.ends_with(",1");
+      ++rows;
+    }
+    EXPECT_EQ(rows_accepted, streamed.accepted);
+    EXPECT_EQ(rows, streamed.pairs);
+    for (const FrameRecord& f : frames) {
+      ASSERT_TRUE(std::getline(frame_rows, row));
+      int64_t marked = 0;
+      for (const Pair& p : f.pairs) marked += p.accepted;
+      EXPECT_TRUE(row.ends_with("," + std::to_string(marked))) << row;
+    }
+
+    const auto j = nlohmann::json::parse(read_all(tmp.path() / "report.json"));
+    EXPECT_EQ(j.at("settings").at("baseline"), *settings.baseline);
+    EXPECT_EQ(
+        j.at("inputs").at("baseline"),
+        nlohmann::json(
+            {{"file", *settings.baseline}, {"entries", 120}, {"checked", 90}, {"unmatched", 7}}));
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const auto& record = j.at("frames").at(i);
+      int64_t marked = 0;
+      for (size_t k = 0; k < frames[i].pairs.size(); ++k) {
+        EXPECT_EQ(record.at("pairs").at(k).at("accepted"), frames[i].pairs[k].accepted);
+        marked += frames[i].pairs[k].accepted;
+      }
+      EXPECT_EQ(record.at("counts").at("accepted"), marked);
+    }
+    const auto& summary = j.at("summary");
+    EXPECT_EQ(summary.at("accepted"), streamed.accepted);
+    EXPECT_EQ(summary.at("accepted_crossing"), streamed.accepted_crossing);
+    EXPECT_EQ(summary.at("new_pairs"), streamed.pairs - streamed.accepted);
+    EXPECT_EQ(summary.at("new_crossing"), streamed.crossing - streamed.accepted_crossing);
+    EXPECT_EQ(summary.at("frames_with_new_pairs"), streamed.frames_with_new_pairs);
+    ASSERT_TRUE(streamed.first_new_frame.has_value());
+    EXPECT_EQ(summary.at("first_new_frame"), *streamed.first_new_frame);
+    EXPECT_EQ(summary.at("failed"), streamed.pairs > streamed.accepted);
+
+    // The same frames without a baseline: no accepted column or member at all.
+    settings.baseline.reset();
+    const TempDir plain;
+    expect_streamed_as_whole(plain.path(), settings, inputs, frames, 1);
+    for (const char* name : {"pairs.csv", "frames.csv", "report.json"})
+      EXPECT_EQ(read_all(plain.path() / name).find("accepted"), std::string::npos) << name;
   }
 }
 
@@ -759,14 +853,26 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
                                 const Summary& s) {
   int64_t with_crossings = 0, with_pairs = 0, pairs = 0, crossing = 0, degenerate = 0;
   int64_t uncertain = 0, confirmed = 0, topology = 0, reused = 0;
+  int64_t accepted = 0, accepted_crossing = 0, with_new = 0;
+  std::optional<int64_t> first_new;
   double check = 0, read = 0, max_depth = 0;
   std::optional<size_t> worst;
   std::tuple<int64_t, int64_t, int64_t> worst_key{-1, -1, 0};
   for (size_t i = 0; i < n; ++i) {
     const FrameRecord& f = frames[i];
     int64_t frame_crossing = 0;
-    for (const Pair& p : f.pairs) frame_crossing += p.kind == PairKind::crossing;
+    int64_t frame_accepted = 0;
+    for (const Pair& p : f.pairs) {
+      frame_crossing += p.kind == PairKind::crossing;
+      frame_accepted += p.accepted;
+      accepted_crossing += p.accepted && p.kind == PairKind::crossing;
+    }
     const int64_t frame_pairs = static_cast<int64_t>(f.pairs.size());
+    accepted += frame_accepted;
+    if (frame_accepted < frame_pairs) {
+      with_new += 1;
+      if (!first_new) first_new = f.frame;
+    }
     with_crossings += frame_crossing > 0;
     with_pairs += frame_pairs > 0;
     pairs += frame_pairs;
@@ -798,6 +904,10 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
   EXPECT_EQ(s.topology_changes, topology);
   EXPECT_EQ(s.reused_pairs, reused);
   EXPECT_EQ(s.max_depth, max_depth);
+  EXPECT_EQ(s.accepted, accepted);
+  EXPECT_EQ(s.accepted_crossing, accepted_crossing);
+  EXPECT_EQ(s.frames_with_new_pairs, with_new);
+  EXPECT_EQ(s.first_new_frame, first_new);
   EXPECT_DOUBLE_EQ(s.check_seconds, check);
   EXPECT_DOUBLE_EQ(s.read_seconds, read);
   EXPECT_EQ(s.worst_frame, worst);
@@ -809,8 +919,9 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
     EXPECT_EQ(s.worst->crossing, std::get<0>(worst_key));
     EXPECT_EQ(s.worst->pairs, static_cast<int64_t>(w.pairs.size()));
   }
-  const bool failed = fail_on == FailOn::crossing ? crossing > 0
-                      : fail_on == FailOn::any    ? pairs > 0
+  // Pairs a baseline accepts never fail the run.
+  const bool failed = fail_on == FailOn::crossing ? crossing > accepted_crossing
+                      : fail_on == FailOn::any    ? pairs > accepted
                                                   : false;
   EXPECT_EQ(s.failed, failed);
 }
@@ -824,6 +935,9 @@ TEST(SummaryAccumulator, MatchesABruteForceRecountAfterEveryFrame) {
     // Ties for the worst frame: the same counts again later must not take its place.
     frames[40].pairs = frames[20].pairs;
     frames[41].pairs = frames[20].pairs;
+    // Seeds 13 and 14: a baseline's marks, on every pair of most frames (which then have no new
+    // pair) and on some pairs of the others.
+    if (seed >= 13) accept_at_random(frames, seed);
     for (FailOn fail_on : {FailOn::crossing, FailOn::any, FailOn::none}) {
       SummaryAccumulator accumulator(fail_on);
       expect_brute_force_summary(frames, 0, fail_on, accumulator.summary());

@@ -38,16 +38,20 @@ std::string csv_field(std::string_view field) {
   return quoted;
 }
 
-std::string_view pairs_csv_header_for(std::span<const ObjectInput> objects) {
-  return objects.empty() ? pairs_csv_header : scene_pairs_csv_header;
+std::string pairs_csv_header_for(std::span<const ObjectInput> objects, bool baseline) {
+  std::string header(objects.empty() ? pairs_csv_header : scene_pairs_csv_header);
+  if (baseline) header += ",accepted";
+  return header;
 }
 
-std::string_view frames_csv_header_for(std::span<const ObjectInput> objects) {
-  return objects.empty() ? frames_csv_header : scene_frames_csv_header;
+std::string frames_csv_header_for(std::span<const ObjectInput> objects, bool baseline) {
+  std::string header(objects.empty() ? frames_csv_header : scene_frames_csv_header);
+  if (baseline) header += ",accepted";
+  return header;
 }
 
-void append_pairs_rows(std::string& out, const FrameRecord& f,
-                       std::span<const ObjectInput> objects) {
+void append_pairs_rows(std::string& out, const FrameRecord& f, std::span<const ObjectInput> objects,
+                       bool baseline) {
   // std::to_chars into a line buffer, each line appended to `out`: a 100K-pair frame is
   // written in milliseconds, and the bytes do not depend on a stream's locale or flags.
   char line[128];
@@ -72,6 +76,7 @@ void append_pairs_rows(std::string& out, const FrameRecord& f,
     *q++ = ',';
     q = std::to_chars(q, q + 12, p.poly_b).ptr;
     if (names.empty()) {
+      if (baseline) q = std::copy_n(p.accepted ? ",1" : ",0", 2, q);
       *q++ = '\n';
       out.append(line, q);
       return;
@@ -81,6 +86,7 @@ void append_pairs_rows(std::string& out, const FrameRecord& f,
     out += pair_object_name(names, f, p, p.object_a);
     out += ',';
     out += pair_object_name(names, f, p, p.object_b);
+    if (baseline) out += p.accepted ? ",1" : ",0";
     out += '\n';
   };
   // Records are sorted by construction (make_frame_record); only a record built otherwise
@@ -97,15 +103,15 @@ void append_pairs_rows(std::string& out, const FrameRecord& f,
   for (const Pair* p : sorted) write_row(*p);
 }
 
-void write_pairs_rows(std::ostream& out, const FrameRecord& f,
-                      std::span<const ObjectInput> objects) {
+void write_pairs_rows(std::ostream& out, const FrameRecord& f, std::span<const ObjectInput> objects,
+                      bool baseline) {
   std::string rows;
-  append_pairs_rows(rows, f, objects);
+  append_pairs_rows(rows, f, objects, baseline);
   out.write(rows.data(), static_cast<std::streamsize>(rows.size()));
 }
 
-void write_frames_row(std::ostream& out, const FrameRecord& f,
-                      std::span<const ObjectInput> objects) {
+void write_frames_row(std::ostream& out, const FrameRecord& f, std::span<const ObjectInput> objects,
+                      bool baseline) {
   char numbers[256];
   const int64_t crossing = f.crossing_count();
   const int64_t pairs = static_cast<int64_t>(f.pairs.size());
@@ -120,19 +126,22 @@ void write_frames_row(std::ostream& out, const FrameRecord& f,
                       f.inside_vertices(), f.max_depth());
     out.write(numbers, n);
   }
+  if (baseline) out << ',' << f.accepted_count();
   out << '\n';
 }
 
 void write_pairs_csv(std::ostream& out, const Report& report) {
-  out << pairs_csv_header_for(report.inputs.objects) << '\n';
+  const bool baseline = report.settings.baseline.has_value();
+  out << pairs_csv_header_for(report.inputs.objects, baseline) << '\n';
   for (size_t i : frame_order(report))
-    write_pairs_rows(out, report.frames[i], report.inputs.objects);
+    write_pairs_rows(out, report.frames[i], report.inputs.objects, baseline);
 }
 
 void write_frames_csv(std::ostream& out, const Report& report) {
-  out << frames_csv_header_for(report.inputs.objects) << '\n';
+  const bool baseline = report.settings.baseline.has_value();
+  out << frames_csv_header_for(report.inputs.objects, baseline) << '\n';
   for (size_t i : frame_order(report))
-    write_frames_row(out, report.frames[i], report.inputs.objects);
+    write_frames_row(out, report.frames[i], report.inputs.objects, baseline);
 }
 
 }  // namespace snag::report

@@ -78,7 +78,7 @@ void add_scene_members(ordered_json& j, const FrameRecord& f,
 
 /// A frame's record without its pairs (an empty array in their place: json_frame_element
 /// writes them, the one part of the report that grows with the pairs).
-ordered_json frame_json(const FrameRecord& f, std::span<const ObjectInput> objects) {
+ordered_json frame_json(const FrameRecord& f, std::span<const ObjectInput> objects, bool baseline) {
   const int64_t crossing = f.crossing_count();
   ordered_json degenerate = ordered_json::array();
   for (const Face& d : f.degenerate) {
@@ -105,6 +105,7 @@ ordered_json frame_json(const FrameRecord& f, std::span<const ObjectInput> objec
                  {"filtered_tests", f.filtered_tests},
                  {"uncertain_tests", f.uncertain_tests},
                  {"confirmed_pairs", f.confirmed_pairs}};
+  if (baseline) j["counts"]["accepted"] = f.accepted_count();
   j["seconds"] = seconds_json(f);
   j["pairs"] = ordered_json::array();
   j["degenerate"] = std::move(degenerate);
@@ -180,6 +181,14 @@ ordered_json summary_json(const Report& run, const Summary& s) {
     j["reused_pairs"] = s.reused_pairs;
     j["max_depth"] = s.max_depth;
   }
+  if (run.settings.baseline) {
+    j["accepted"] = s.accepted;
+    j["accepted_crossing"] = s.accepted_crossing;
+    j["new_pairs"] = s.pairs - s.accepted;
+    j["new_crossing"] = s.crossing - s.accepted_crossing;
+    j["frames_with_new_pairs"] = s.frames_with_new_pairs;
+    j["first_new_frame"] = s.first_new_frame ? ordered_json(*s.first_new_frame) : nullptr;
+  }
   j["builds"] = run.builds;
   j["rebuilds"] = run.rebuilds;
   j["seconds"] = {{"check", s.check_seconds}, {"read", s.read_seconds}, {"wall", run.wall_seconds}};
@@ -222,9 +231,9 @@ std::string json_file_element(const std::string& file, bool first) {
 /// frame's pairs are most of report.json. Written by hand: a frame can have millions of pairs,
 /// and building a JSON object per pair cost more than checking the frame.
 /// `names`: the scene's object names as JSON strings (json_string), empty for a single mesh.
-/// Appended to `out`.
+/// `baseline`: each pair says whether the baseline accepts it. Appended to `out`.
 void append_pairs_array(std::string& out, const FrameRecord& f, int level,
-                        std::span<const std::string> names) {
+                        std::span<const std::string> names, bool baseline) {
   const std::vector<Pair>& pairs = f.pairs;
   const std::string object_margin = indent(level + 1);
   const bool scene = !names.empty();
@@ -238,6 +247,8 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
   const std::string before_poly_b = ",\"poly_b\":";
   const std::string before_object_a = ",\"object_a\":";
   const std::string before_object_b = ",\"object_b\":";
+  const std::string accepted = ",\"accepted\":true";
+  const std::string not_accepted = ",\"accepted\":false";
   const std::string close = "}";
   // Written through a cursor into space sized for the longest pair, then trimmed: appending
   // piece by piece spent as long on the string's bookkeeping as on the numbers.
@@ -246,7 +257,8 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
   const size_t longest_pair =
       open_next.size() + before_b.size() + crossing_then_poly.size() + before_poly_b.size() +
       close.size() + 4 * 11 +
-      (scene ? before_object_a.size() + before_object_b.size() + 2 * (longest_name + 2) : 0);
+      (scene ? before_object_a.size() + before_object_b.size() + 2 * (longest_name + 2) : 0) +
+      (baseline ? not_accepted.size() : 0);
   const size_t start = out.size();
   out.resize(start + 1 + pairs.size() * longest_pair);
   char* at = out.data() + start;
@@ -278,6 +290,7 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
       put(before_object_b);
       put(pair_object_name(names, f, p, p.object_b));
     }
+    if (baseline) put(p.accepted ? accepted : not_accepted);
     put(close);
   }
   out.resize(static_cast<size_t>(at - out.data()));
@@ -290,8 +303,8 @@ void append_pairs_array(std::string& out, const FrameRecord& f, int level,
 }
 
 void append_json_frame_element(std::string& out, const FrameRecord& frame, bool first,
-                               std::span<const ObjectInput> objects) {
-  const std::string text = array_element(frame_json(frame, objects), frames_level, first);
+                               std::span<const ObjectInput> objects, bool baseline) {
+  const std::string text = array_element(frame_json(frame, objects, baseline), frames_level, first);
   if (frame.pairs.empty()) {
     out += text;
     return;
@@ -316,20 +329,20 @@ void append_json_frame_element(std::string& out, const FrameRecord& frame, bool 
   // record with the pairs in it.
   const size_t value_at = at + placeholder.size() - 2;
   out.append(text, 0, value_at);
-  append_pairs_array(out, frame, member_level, names);
+  append_pairs_array(out, frame, member_level, names, baseline);
   out.append(text, value_at + 2);
 }
 
 std::string json_frame_element(const FrameRecord& frame, bool first,
-                               std::span<const ObjectInput> objects) {
+                               std::span<const ObjectInput> objects, bool baseline) {
   std::string text;
-  append_json_frame_element(text, frame, first, objects);
+  append_json_frame_element(text, frame, first, objects, baseline);
   return text;
 }
 
 void write_report_json_head(std::ostream& out, const Report& run) {
   const Settings& set = run.settings;
-  const ordered_json settings = {
+  ordered_json settings = {
       {"backend", set.backend},
       {"backend_requested", set.backend_requested},
       {"threads", set.threads},
@@ -340,6 +353,7 @@ void write_report_json_head(std::ostream& out, const Report& run) {
       {"rebuild_threshold", set.rebuild_threshold},
       {"fail_on", std::string(to_string(set.fail_on))},
       {"frames", set.frames ? ordered_json(*set.frames) : ordered_json(nullptr)}};
+  if (set.baseline) settings["baseline"] = *set.baseline;
   // The root object (level 0) with its members at level 1, up to the frames array's "[".
   out << "{\n";
   out << member("schema", std::string(json_schema), 1) << ",\n";
@@ -363,6 +377,16 @@ void write_report_json_tail(std::ostream& out, const Report& run, const Summary&
   out << member("coincident_vertices", run.inputs.coincident_vertices, 2) << ",\n";
   out << member("welded_vertices", run.inputs.welded_vertices, 2);
   if (run.inputs.scene()) out << ",\n" << member("objects", objects_json(run.inputs.objects), 2);
+  if (run.settings.baseline) {
+    const BaselineUse& use = run.inputs.baseline;
+    out << ",\n"
+        << member("baseline",
+                  {{"file", *run.settings.baseline},
+                   {"entries", use.entries},
+                   {"checked", use.checked},
+                   {"unmatched", use.unmatched}},
+                  2);
+  }
   out << "\n";
   out << indent(1) << "},\n";
   out << member("summary", summary_json(run, summary), 1) << "\n";
@@ -387,7 +411,8 @@ std::string report_json(const Report& report) {
       },
       [&](std::ostream& frames) {
         for (size_t i = 0; i < report.frames.size(); ++i)
-          frames << json_frame_element(report.frames[i], i == 0, report.inputs.objects);
+          frames << json_frame_element(report.frames[i], i == 0, report.inputs.objects,
+                                       report.settings.baseline.has_value());
       });
   return out.str();
 }

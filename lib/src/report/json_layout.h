@@ -22,13 +22,14 @@ std::string json_file_element(const std::string& file, bool first);
 /// `objects`: the run's Inputs::objects, empty for a single mesh; in a scene run the record
 /// also names the objects of its pairs and degenerate faces and has the scene members
 /// (objects, checks, penetration). An object index outside `objects`, or frame.objects not
-/// one per object, throws InternalError.
+/// one per object, throws InternalError. `baseline` (Settings::baseline set): each pair's
+/// `accepted` and the counts' `accepted`.
 std::string json_frame_element(const FrameRecord& frame, bool first,
-                               std::span<const ObjectInput> objects);
+                               std::span<const ObjectInput> objects, bool baseline);
 /// json_frame_element's text appended to `out`, a buffer the caller can keep from frame to frame
 /// (ReportStream's writer does).
 void append_json_frame_element(std::string& out, const FrameRecord& frame, bool first,
-                               std::span<const ObjectInput> objects);
+                               std::span<const ObjectInput> objects, bool baseline);
 
 /// Writes report.json: `run`'s head (version, settings), the frames elements `write_frames`
 /// writes (what json_frame_element gave, in order), then the inputs with the inputs.files
@@ -37,7 +38,8 @@ void append_json_frame_element(std::string& out, const FrameRecord& frame, bool 
 /// The inputs follow the frames because a run knows them only at its end (the files read,
 /// whose ids, the vertices welded), while the frames, most of the bytes, can then go straight
 /// to the file as they finish. run.frames is not read; run.inputs.objects, when not empty,
-/// adds inputs.objects and the summary's scene members.
+/// adds inputs.objects and the summary's scene members; run.settings.baseline, when set,
+/// settings.baseline, inputs.baseline (run.inputs.baseline) and the summary's baseline members.
 void write_report_json(std::ostream& out, const Report& run, const Summary& summary,
                        const std::function<void(std::ostream&)>& write_files,
                        const std::function<void(std::ostream&)>& write_frames);

@@ -30,6 +30,16 @@ int64_t FrameRecord::crossing_count() const {
                        [](const Pair& p) { return p.kind == detect::PairKind::crossing; });
 }
 
+int64_t FrameRecord::accepted_count() const {
+  return std::count_if(pairs.begin(), pairs.end(), [](const Pair& p) { return p.accepted; });
+}
+
+int64_t FrameRecord::accepted_crossing_count() const {
+  return std::count_if(pairs.begin(), pairs.end(), [](const Pair& p) {
+    return p.accepted && p.kind == detect::PairKind::crossing;
+  });
+}
+
 int64_t FrameRecord::reused_pairs() const {
   int64_t n = 0;
   for (const CheckFrame& c : checks)
@@ -116,6 +126,13 @@ void SummaryAccumulator::add(const FrameRecord& frame) {
   s.pairs += pairs;
   s.crossing += crossing;
   s.touching += pairs - crossing;
+  const int64_t accepted = frame.accepted_count();
+  s.accepted += accepted;
+  s.accepted_crossing += frame.accepted_crossing_count();
+  if (accepted < pairs) {
+    s.frames_with_new_pairs += 1;
+    if (!s.first_new_frame) s.first_new_frame = frame.frame;
+  }
   s.degenerate += static_cast<int64_t>(frame.degenerate.size());
   s.uncertain_tests += frame.uncertain_tests;
   s.confirmed_pairs += frame.confirmed_pairs;
@@ -134,10 +151,10 @@ void SummaryAccumulator::add(const FrameRecord& frame) {
   }
   switch (fail_on_) {
     case FailOn::crossing:
-      s.failed = s.crossing > 0;
+      s.failed = s.crossing > s.accepted_crossing;
       break;
     case FailOn::any:
-      s.failed = s.pairs > 0;
+      s.failed = s.pairs > s.accepted;
       break;
     case FailOn::none:
       s.failed = false;

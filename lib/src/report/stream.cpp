@@ -77,13 +77,15 @@ struct ReportStream::Files {
 
 ReportStream::ReportStream(std::optional<fs::path> dir, std::string snag_version, Settings settings,
                            std::vector<ObjectInput> objects, int formatters)
-    : objects_(std::move(objects)), accumulator_(settings.fail_on) {
+    : objects_(std::move(objects)),
+      baseline_(settings.baseline.has_value()),
+      accumulator_(settings.fail_on) {
   run_.snag_version = std::move(snag_version);
   run_.settings = std::move(settings);
   if (!dir) return;
   files_ = std::make_unique<Files>(*dir);
-  files_->pairs_csv.out() << pairs_csv_header_for(objects_) << '\n';
-  files_->frames_csv.out() << frames_csv_header_for(objects_) << '\n';
+  files_->pairs_csv.out() << pairs_csv_header_for(objects_, baseline_) << '\n';
+  files_->frames_csv.out() << frames_csv_header_for(objects_, baseline_) << '\n';
   write_report_json_head(files_->report_json.out(), run_);
   const int threads = std::clamp(formatters, 1, static_cast<int>(write_ahead));
   try {
@@ -117,8 +119,9 @@ void ReportStream::format_loop() {
       spare_texts_.pop_back();
     }
     unlocked_unless_failed(lock, write_error_, [&] {
-      append_pairs_rows(entry.pairs_text, entry.frame, objects_);
-      append_json_frame_element(entry.json_text, entry.frame, entry.sequence == 0, objects_);
+      append_pairs_rows(entry.pairs_text, entry.frame, objects_, baseline_);
+      append_json_frame_element(entry.json_text, entry.frame, entry.sequence == 0, objects_,
+                                baseline_);
     });
     entry.formatted = true;
     write_ready(lock);
@@ -147,7 +150,7 @@ void ReportStream::write_frame(Unwritten& entry) {
     file.out().write(text.data(), static_cast<std::streamsize>(text.size()));
   };
   write(files_->pairs_csv, entry.pairs_text);
-  write_frames_row(files_->frames_csv.out(), entry.frame, objects_);
+  write_frames_row(files_->frames_csv.out(), entry.frame, objects_, baseline_);
   files_->file_names.out() << json_file_element(entry.frame.file, entry.sequence == 0);
   write(files_->report_json, entry.json_text);
   for (const StagedFile* f :

@@ -34,6 +34,9 @@ struct Pair {
   int32_t poly_b = 0;
   int32_t object_a = 0;
   int32_t object_b = 0;
+  /// Listed in the run's baseline (--baseline, baseline.h): reported, but it does not fail the
+  /// run. Always false without a baseline.
+  bool accepted = false;
   friend bool operator==(const Pair&, const Pair&) = default;
 };
 
@@ -119,6 +122,8 @@ struct FrameRecord {
 
   int64_t crossing_count() const;
   int64_t touching_count() const { return static_cast<int64_t>(pairs.size()) - crossing_count(); }
+  int64_t accepted_count() const;           ///< pairs the baseline accepts
+  int64_t accepted_crossing_count() const;  ///< crossing pairs the baseline accepts
 };
 
 /// Copies a checker's counts, rebuild, tree quality and stage times into `record` (what every
@@ -150,6 +155,9 @@ struct Settings {
   double rebuild_threshold = 0;  ///< quality factor that triggers a rebuild under "auto"
   FailOn fail_on = FailOn::crossing;
   std::optional<std::string> frames;  ///< --frames selection as given, if any
+  /// --baseline file as given, if any: pairs it lists are accepted (Pair::accepted), and the
+  /// reports then have their `accepted` columns and members.
+  std::optional<std::string> baseline;
 };
 
 /// One object of a scene run (Inputs::objects).
@@ -168,6 +176,14 @@ struct ObjectInput {
   friend bool operator==(const ObjectInput&, const ObjectInput&) = default;
 };
 
+/// What a run made of its baseline (report.json's inputs.baseline), from Baseline::use().
+struct BaselineUse {
+  int64_t entries = 0;    ///< distinct pairs the file lists
+  int64_t checked = 0;    ///< entries of the frames checked, every-frame entries included
+  int64_t unmatched = 0;  ///< of those, entries that accepted no pair
+  friend bool operator==(const BaselineUse&, const BaselineUse&) = default;
+};
+
 struct Inputs {
   std::string sequence;      ///< the SEQUENCE argument as given (a scene run: the scene file)
   std::string ids = "file";  ///< "file" (snag's OBJ/PLY readers) or "assimp"
@@ -177,6 +193,7 @@ struct Inputs {
   /// A scene run's objects (--obstacle, --scene, --split-groups); empty for a single mesh,
   /// whose reports keep the single-mesh columns.
   std::vector<ObjectInput> objects;
+  BaselineUse baseline;  ///< written only when Settings::baseline is set
   bool scene() const { return !objects.empty(); }
 };
 
@@ -213,6 +230,12 @@ struct Summary {
   int64_t pairs = 0;
   int64_t crossing = 0;
   int64_t touching = 0;
+  // With a baseline: the pairs it accepts, and where the first pair it does not is. Without
+  // one, accepted and accepted_crossing stay 0, and every pair is new.
+  int64_t accepted = 0;
+  int64_t accepted_crossing = 0;
+  int64_t frames_with_new_pairs = 0;
+  std::optional<int64_t> first_new_frame;  ///< number of the first frame added with a new pair
   int64_t degenerate = 0;
   int64_t uncertain_tests = 0;
   int64_t confirmed_pairs = 0;
@@ -221,7 +244,9 @@ struct Summary {
   double max_depth = 0;      ///< deepest Penetration::max_depth of any frame (0 when none)
   double check_seconds = 0;  ///< sum of the frames' checking times, in the order added
   double read_seconds = 0;
-  bool failed = false;  ///< the run fails under settings.fail_on
+  /// The run fails under settings.fail_on: a crossing pair (or, with `any`, a pair) that the
+  /// baseline does not accept.
+  bool failed = false;
   friend bool operator==(const Summary&, const Summary&) = default;
 };
 

@@ -118,6 +118,7 @@ class ReportStream {
 
   Report run_;                        ///< report.json's head and totals; its frames stay empty
   std::vector<ObjectInput> objects_;  ///< the constructor's: the names of rows and records
+  bool baseline_ = false;  ///< settings.baseline given: the reports' accepted columns and members
   SummaryAccumulator accumulator_;
   std::optional<int64_t> last_frame_;
   std::unique_ptr<Files> files_;
