@@ -153,7 +153,7 @@ std::string frame_note(const report::FrameRecord& r, bool baseline) {
   } else {
     note += std::to_string(r.crossing_count()) + " crossing, " +
             std::to_string(r.touching_count()) + " touching";
-    if (baseline) note += " (" + std::to_string(r.accepted_count()) + " accepted)";
+    if (baseline) note += ", " + std::to_string(r.accepted_count()) + " accepted";
   }
   if (!r.degenerate.empty()) note += ", " + std::to_string(r.degenerate.size()) + " degenerate";
   if (r.topology_changed) note += " (topology changed)";
@@ -199,6 +199,37 @@ std::string objects_line(const std::vector<report::ObjectInput>& objects, bool r
   return line;
 }
 
+/// The summary's lines about a run's baseline: what it listed and what matched, the pairs it
+/// accepted, the new ones, and where the run first failed.
+void print_baseline_summary(std::ostream& out, const report::Summary& s,
+                            const report::BaselineUse& use, const std::string& file) {
+  constexpr size_t kLinesNamed = 5;
+  out << "baseline             " << file << ": " << use.entries
+      << (use.entries == 1 ? " entry" : " entries");
+  if (use.left_out > 0) out << " (" << use.left_out << " rows marked accepted 0 left out)";
+  out << ", " << use.checked << " for the frames checked, " << use.unmatched << " matched no pair";
+  if (use.unmatched > 0) {
+    out << " (line";
+    out << (use.unmatched == 1 ? " " : "s ");
+    for (size_t i = 0; i < std::min(use.unmatched_lines.size(), kLinesNamed); ++i)
+      out << (i ? ", " : "") << use.unmatched_lines[i];
+    if (use.unmatched_lines.size() > kLinesNamed) out << ", ...";
+    out << ")";
+  }
+  out << "\n";
+  out << "accepted pairs       " << s.accepted << " (" << s.accepted_crossing << " crossing, "
+      << s.accepted - s.accepted_crossing << " touching)\n";
+  const int64_t new_pairs = s.pairs - s.accepted;
+  const int64_t new_crossing = s.crossing - s.accepted_crossing;
+  out << "new pairs            " << new_pairs;
+  if (new_pairs > 0)
+    out << " (" << new_crossing << " crossing, " << new_pairs - new_crossing << " touching) in "
+        << plural(s.frames_with_new_pairs, "frame") << ", the first in frame "
+        << *s.first_new_frame;
+  out << "\n";
+  if (s.first_failing_frame) out << "first failing frame  " << *s.first_failing_frame << "\n";
+}
+
 /// `baseline_file`: --baseline as given, empty without one (inputs.baseline is then not read).
 void print_summary(std::ostream& out, const report::Summary& s, const RunTotals& totals,
                    const std::string& rebuild_policy, const std::string& out_dir,
@@ -216,21 +247,7 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
   }
   out << "pairs                " << s.pairs << " (" << s.crossing << " crossing, " << s.touching
       << " touching)\n";
-  if (!baseline_file.empty()) {
-    const report::BaselineUse& use = inputs.baseline;
-    out << "baseline             " << baseline_file << ": " << use.checked
-        << (use.checked == 1 ? " entry" : " entries") << " for the frames checked, "
-        << use.unmatched << " matched no pair\n";
-    out << "accepted pairs       " << s.accepted << " (" << s.accepted_crossing << " crossing, "
-        << s.accepted - s.accepted_crossing << " touching)\n";
-    const int64_t new_pairs = s.pairs - s.accepted;
-    const int64_t new_crossing = s.crossing - s.accepted_crossing;
-    out << "new pairs            " << new_pairs;
-    if (new_pairs > 0)
-      out << " (" << new_crossing << " crossing, " << new_pairs - new_crossing << " touching) in "
-          << plural(s.frames_with_new_pairs, "frame") << ", the first frame " << *s.first_new_frame;
-    out << "\n";
-  }
+  if (!baseline_file.empty()) print_baseline_summary(out, s, inputs.baseline, baseline_file);
   if (s.degenerate > 0) out << "degenerate faces     " << s.degenerate << "\n";
   if (inputs.scene()) {
     out << "reused pairs         " << s.reused_pairs << " (checks whose objects did not move)\n";
@@ -348,8 +365,10 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->check(CLI::IsMember({"crossing", "any", "none"}))
       ->capture_default_str();
   cmd->add_option("--baseline", o.baseline,
-                  "Pairs accepted earlier (a pairs.csv, rows cut as wanted; frame * for every "
-                  "frame): reported as accepted, they do not fail the run")
+                  "Pairs accepted earlier: a pairs.csv (frame, face_a, face_b, optional kind; "
+                  "object_a, object_b with several objects), rows cut as wanted, frame * for "
+                  "every frame, rows marked accepted 0 left out. Reported, they do not fail the "
+                  "run")
       ->type_name("FILE")
       ->check(non_empty("a baseline file"))
       ->check(not_an_option("a baseline file"));
@@ -460,10 +479,21 @@ int run_check(const CheckOptions& o) {
   sequence.threads = threads;
   sequence.gpu = backend_name == "cuda";
   CollapsedFrames collapsed;
+  bool topology_warned = false;
   check_scene(
       resolved, *checker, sequence, scene_run, inputs,
       [&](report::FrameRecord&& record) {
-        if (baseline) baseline->mark(record);
+        if (baseline) {
+          baseline->mark(record);
+          // Baseline rows name faces by id, and ids mean other faces after the face list
+          // changed: said once, at the first such frame.
+          if (record.topology_changed && !topology_warned) {
+            topology_warned = true;
+            warn("frame " + std::to_string(record.frame) +
+                 " has another face list than the frame before: the --baseline's face ids may "
+                 "name other faces from there on");
+          }
+        }
         collapsed.note(record, warn);
         progress.update(reports.summary().frames_checked + 1,
                         frame_note(record, baseline.has_value()));

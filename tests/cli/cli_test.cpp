@@ -530,8 +530,9 @@ TEST(CliBaseline, TheDrapesPairsLessSomeFailOnExactlyThoseLeftOut) {
       {"check", drape, "--fail-on", "any", "--baseline", "first/pairs.csv", "--out", "all"},
       tmp.path());
   EXPECT_EQ(all.status, 0) << context(all);
-  EXPECT_NE(all.out.find("baseline             first/pairs.csv: " + std::to_string(rows.size()) +
-                         " entries for the frames checked, 0 matched no pair\n"),
+  const std::string count = std::to_string(rows.size());
+  EXPECT_NE(all.out.find("baseline             first/pairs.csv: " + count + " entries, " + count +
+                         " for the frames checked, 0 matched no pair\n"),
             std::string::npos)
       << all.out;
   EXPECT_NE(all.out.find("new pairs            0\n"), std::string::npos) << all.out;
@@ -573,7 +574,7 @@ TEST(CliBaseline, TheDrapesPairsLessSomeFailOnExactlyThoseLeftOut) {
   EXPECT_NE(r.out.find("new pairs            " + std::to_string(new_pairs) + " (" +
                        std::to_string(left_out_crossing) + " crossing, " +
                        std::to_string(new_pairs - left_out_crossing) + " touching) in " +
-                       std::to_string(new_frames.size()) + " frames, the first frame " +
+                       std::to_string(new_frames.size()) + " frames, the first in frame " +
                        left_out.front().substr(0, left_out.front().find(',')) + "\n"),
             std::string::npos)
       << r.out;
@@ -593,6 +594,20 @@ TEST(CliBaseline, TheDrapesPairsLessSomeFailOnExactlyThoseLeftOut) {
   EXPECT_EQ(j.at("summary").at("new_pairs"), new_pairs);
   EXPECT_EQ(j.at("summary").at("new_crossing"), left_out_crossing);
   EXPECT_EQ(j.at("summary").at("failed"), left_out_crossing > 0);
+
+  // That run's pairs.csv as the next baseline: its new pairs are marked 0 and stay new until
+  // someone marks them 1 (or takes the pairs of a run without a baseline).
+  const RunResult next = run_snag(
+      {"check", drape, "--baseline", "second/pairs.csv", "--fail-on", "any", "-q"}, tmp.path());
+  EXPECT_EQ(next.status, 1) << context(next);
+  EXPECT_NE(next.out.find("second/pairs.csv: " + std::to_string(rows.size() - left_out.size()) +
+                          " entries (" + std::to_string(left_out.size()) +
+                          " rows marked accepted 0 left out)"),
+            std::string::npos)
+      << next.out;
+  EXPECT_NE(next.out.find("new pairs            " + std::to_string(new_pairs) + " ("),
+            std::string::npos)
+      << next.out;
 }
 
 TEST(CliBaseline, HandWrittenRowsForEveryFrameAndByKind) {
@@ -603,17 +618,22 @@ TEST(CliBaseline, HandWrittenRowsForEveryFrameAndByKind) {
   const RunResult every = run_snag({"check", "seq", "--baseline", "every.csv"}, tmp.path());
   EXPECT_EQ(every.status, 1) << context(every);
   EXPECT_NE(every.out.find("new pairs            1 (1 crossing, 0 touching) in 1 frame, the "
-                           "first frame 2\n"),
+                           "first in frame 2\nfirst failing frame  2\n"),
             std::string::npos)
       << every.out;
-  EXPECT_NE(every.err.find("[1/3] frame 1: 1 crossing, 0 touching (1 accepted)"), std::string::npos)
+  EXPECT_NE(every.err.find("[1/3] frame 1: 1 crossing, 0 touching, 1 accepted"), std::string::npos)
+      << every.err;
+  // Frame 2 reorders the faces: the ids of a baseline may now name other faces.
+  EXPECT_NE(every.err.find("snag: warning: frame 2 has another face list than the frame before: "
+                           "the --baseline's face ids may name other faces from there on"),
+            std::string::npos)
       << every.err;
 
   write_text(tmp.path() / "both.csv", "frame,face_a,face_b\n1,1,2\n2,0,2\n7,0,1\n");
   const RunResult both = run_snag({"check", "seq", "--baseline", "both.csv"}, tmp.path());
   EXPECT_EQ(both.status, 0) << context(both);
   // Frame 7 is not checked: its entry is not counted among the frames checked.
-  EXPECT_NE(both.out.find("both.csv: 2 entries for the frames checked, 0 matched no pair"),
+  EXPECT_NE(both.out.find("both.csv: 3 entries, 2 for the frames checked, 0 matched no pair\n"),
             std::string::npos)
       << both.out;
 
@@ -622,7 +642,7 @@ TEST(CliBaseline, HandWrittenRowsForEveryFrameAndByKind) {
              "frame,face_a,face_b,kind\n1,1,2,touching\n2,0,2,crossing\n");
   const RunResult touching = run_snag({"check", "seq", "--baseline", "touching.csv"}, tmp.path());
   EXPECT_EQ(touching.status, 1) << context(touching);
-  EXPECT_NE(touching.out.find("2 entries for the frames checked, 1 matched no pair"),
+  EXPECT_NE(touching.out.find("2 entries, 2 for the frames checked, 1 matched no pair (line 2)\n"),
             std::string::npos)
       << touching.out;
 }
@@ -643,6 +663,16 @@ TEST(CliBaseline, ABadBaselineExitsThreeBeforeAnyFrameAndWritesNoReport) {
   const RunResult missing = run_snag({"check", "seq", "--baseline", "none.csv"}, tmp.path());
   EXPECT_EQ(missing.status, 3) << context(missing);
   EXPECT_NE(missing.err.find("none.csv"), std::string::npos) << missing.err;
+
+  // A face the mesh does not have: found at the first frame it applies to.
+  write_text(tmp.path() / "far.csv", "frame,face_a,face_b\n*,0,99\n");
+  const RunResult far =
+      run_snag({"check", "seq", "--baseline", "far.csv", "--out", "out"}, tmp.path());
+  EXPECT_EQ(far.status, 3) << context(far);
+  EXPECT_NE(far.err.find("far.csv:2: face 99 is not a face of frame 1 (3 triangles)"),
+            std::string::npos)
+      << far.err;
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
 
   // A scene run's pairs.csv given to a run of one mesh.
   write_text(tmp.path() / "scene.csv",

@@ -279,8 +279,12 @@ TEST(SceneObstacle, ABaselineNamesEachFacesObject) {
             "3,0,0,crossing,0,0,cloth,body,0\n"
             "3,1,0,crossing,1,0,cloth,body,1\n");
   EXPECT_EQ(column(run, "accepted"), (std::vector<std::string>{"0", "0", "1"}));
-  EXPECT_EQ(run.report.at("inputs").at("baseline"),
-            json({{"file", "accepted.csv"}, {"entries", 2}, {"checked", 2}, {"unmatched", 1}}));
+  EXPECT_EQ(run.report.at("inputs").at("baseline"), json({{"file", "accepted.csv"},
+                                                          {"entries", 2},
+                                                          {"left_out", 0},
+                                                          {"checked", 2},
+                                                          {"unmatched", 1},
+                                                          {"unmatched_lines", {3}}}));
   EXPECT_EQ(run.report.at("summary").at("first_new_frame"), 2);
 
   // An object the run does not have is named, with the run's objects.

@@ -24,10 +24,12 @@ using detect::PairKind;
 constexpr PairKind kCrossing = PairKind::crossing;
 constexpr PairKind kTouching = PairKind::touching;
 
-/// A frame record with these pairs (object 0 throughout unless a pair says otherwise).
+/// A frame record of a 1,000-triangle mesh with these pairs (object 0 throughout unless a pair
+/// says otherwise).
 FrameRecord frame_with(int64_t number, std::vector<Pair> pairs) {
   FrameRecord f;
   f.frame = number;
+  f.triangles = 1000;
   f.pairs = std::move(pairs);
   return f;
 }
@@ -46,6 +48,14 @@ std::vector<ObjectInput> two_objects() {
       {"body, \"v2\"", "obstacle", "body.obj", std::nullopt, true, std::nullopt, 8, 12, "closed"}};
 }
 
+/// What use() should say: the entries, those of the frames checked, the lines of those that
+/// matched no pair, and the rows marked accepted 0.
+BaselineUse expected_use(int64_t entries, int64_t checked, std::vector<int64_t> unmatched_lines,
+                         int64_t left_out = 0) {
+  const auto unmatched = static_cast<int64_t>(unmatched_lines.size());
+  return {entries, left_out, checked, unmatched, std::move(unmatched_lines)};
+}
+
 /// The InputError `parse` throws for `text`: its line and message, for EXPECTs.
 std::pair<int64_t, std::string> refusal(const std::string& text,
                                         const std::vector<ObjectInput>& objects = {}) {
@@ -60,11 +70,10 @@ std::pair<int64_t, std::string> refusal(const std::string& text,
 }
 
 TEST(Baseline, APairsCsvAsSnagWritesItAcceptsItsPairsInTheirFrames) {
-  // A run's own reports, read back: frame 5's two pairs and frame 7's one.
+  // A run's own reports, read back: frame 5's two pairs and frame 7's one (a run without a
+  // baseline: no accepted column, RowsMarkedAcceptedZeroAreLeftOut has one).
   Report run;
-  run.settings.baseline = "earlier.csv";  // its pairs.csv then has the accepted column too
-  run.frames.push_back(
-      frame_with(5, {{1, 9, kCrossing, 1, 9}, {2, 3, kTouching, 2, 2, 0, 0, true}}));
+  run.frames.push_back(frame_with(5, {{1, 9, kCrossing, 1, 9}, {2, 3, kTouching, 2, 2}}));
   run.frames.push_back(frame_with(7, {{4, 6, kCrossing, 4, 6}}));
   std::ostringstream pairs_csv;
   write_pairs_csv(pairs_csv, run);
@@ -76,18 +85,18 @@ TEST(Baseline, APairsCsvAsSnagWritesItAcceptsItsPairsInTheirFrames) {
       frame_with(5, {{1, 9, kCrossing}, {2, 3, kTouching}, {2, 8, kCrossing}, {4, 6, kCrossing}});
   baseline.mark(five);
   EXPECT_EQ(accepted_of(five), (std::set<std::pair<int32_t, int32_t>>{{1, 9}, {2, 3}}));
-  EXPECT_EQ(baseline.use(), (BaselineUse{3, 2, 0}));
+  EXPECT_EQ(baseline.use(), expected_use(3, 2, {}));
 
   // Frame 6 is not in the file: nothing accepted, nothing more checked.
   FrameRecord six = frame_with(6, {{1, 9, kCrossing}});
   baseline.mark(six);
   EXPECT_TRUE(accepted_of(six).empty());
-  EXPECT_EQ(baseline.use(), (BaselineUse{3, 2, 0}));
+  EXPECT_EQ(baseline.use(), expected_use(3, 2, {}));
 
   // Frame 7 without its pair: its entry is checked and matched nothing.
   FrameRecord seven = frame_with(7, {});
   baseline.mark(seven);
-  EXPECT_EQ(baseline.use(), (BaselineUse{3, 3, 1}));
+  EXPECT_EQ(baseline.use(), expected_use(3, 3, {4}));
 }
 
 TEST(Baseline, MarkingSetsAndClearsEveryPairsMark) {
@@ -101,14 +110,82 @@ TEST(Baseline, MarkingSetsAndClearsEveryPairsMark) {
 }
 
 TEST(Baseline, ColumnsAreFoundByNameInAnyOrderAndOthersIgnored) {
+  // Spaces around names and values typed by hand; a row that stops before its optional kind.
   Baseline baseline = Baseline::parse(
-      "note,face_b,kind,frame,face_a,accepted\n"
-      "\"seam, left\",12,crossing,40,11,0\n"
-      "button,30,touching,40,2,1\n",
+      "note, face_b ,kind,frame,face_a\n"
+      "\"seam, left\",12,crossing,40,11\n"
+      "button, 30 ,touching, 40,2\n"
+      "cut short,7\t,\t, 40 ,3\n",
       "b.csv", {});
-  FrameRecord f = frame_with(40, {{11, 12, kCrossing}, {2, 30, kTouching}, {2, 31, kTouching}});
+  FrameRecord f = frame_with(
+      40, {{11, 12, kCrossing}, {2, 30, kTouching}, {2, 31, kTouching}, {3, 7, kCrossing}});
   baseline.mark(f);
-  EXPECT_EQ(accepted_of(f), (std::set<std::pair<int32_t, int32_t>>{{11, 12}, {2, 30}}));
+  EXPECT_EQ(accepted_of(f), (std::set<std::pair<int32_t, int32_t>>{{11, 12}, {2, 30}, {3, 7}}));
+  Baseline short_rows = Baseline::parse("frame,face_a,face_b,kind,poly_a\n40,3,7\n", "b.csv", {});
+  FrameRecord g = frame_with(40, {{3, 7, kCrossing}});
+  short_rows.mark(g);
+  EXPECT_TRUE(g.pairs[0].accepted);
+}
+
+TEST(Baseline, RowsMarkedAcceptedZeroAreLeftOut) {
+  // The pairs.csv of a run with a baseline: its new pairs are marked 0, and taking the file as
+  // the next baseline must not accept them unseen. 1 or nothing accepts.
+  Baseline baseline = Baseline::parse(
+      "frame,face_a,face_b,kind,poly_a,poly_b,accepted\n"
+      "5,1,9,crossing,1,9,1\n"
+      "5,2,8,crossing,2,8,0\n"
+      "5,3,7,touching,3,7,\n"
+      "5,4,6,touching,4,6,0\n",
+      "b.csv", {});
+  FrameRecord f =
+      frame_with(5, {{1, 9, kCrossing}, {2, 8, kCrossing}, {3, 7, kTouching}, {4, 6, kTouching}});
+  baseline.mark(f);
+  EXPECT_EQ(accepted_of(f), (std::set<std::pair<int32_t, int32_t>>{{1, 9}, {3, 7}}));
+  EXPECT_EQ(baseline.use(), expected_use(2, 2, {}, 2));
+  const auto [line, message] = refusal("frame,face_a,face_b,accepted\n5,1,9,yes\n");
+  EXPECT_EQ(line, 2);
+  EXPECT_NE(message.find("accepted: expected 1, 0 or nothing, got 'yes'"), std::string::npos)
+      << message;
+}
+
+TEST(Baseline, AFacePastTheFramesTrianglesIsAnErrorWithItsLine) {
+  Baseline baseline =
+      Baseline::parse("frame,face_a,face_b\n1,0,1\n2,5,999\n*,3,4\n2,5,1000\n", "mine.csv", {});
+  FrameRecord one = frame_with(1, {});
+  baseline.mark(one);  // the every-frame entry and frame 1's are within 1,000 triangles
+  FrameRecord two = frame_with(2, {});
+  try {
+    baseline.mark(two);
+    ADD_FAILURE() << "face 1000 of a 1,000-triangle frame was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.path(), "mine.csv");
+    EXPECT_EQ(e.line(), 5);
+    EXPECT_NE(std::string(e.what()).find("face 1000 is not a face of frame 2 (1000 triangles)"),
+              std::string::npos)
+        << e.what();
+  }
+  // An every-frame entry is bounded by every frame.
+  Baseline every = Baseline::parse("frame,face_a,face_b\n*,3,40\n", "mine.csv", {});
+  FrameRecord small = frame_with(9, {});
+  small.triangles = 40;
+  EXPECT_THROW(every.mark(small), InputError);
+}
+
+TEST(Baseline, SceneFacesAreBoundedByTheirObjectUnlessItIsAGroup) {
+  std::vector<ObjectInput> objects = two_objects();
+  const std::string text =
+      "frame,face_a,face_b,object_a,object_b\n"
+      "1,0,11,dress,\"body, \"\"v2\"\"\"\n";
+  FrameRecord f = frame_with(1, {});
+  f.objects = {ObjectFrame{}, ObjectFrame{}};
+  f.objects[0].triangles = 20;
+  f.objects[1].triangles = 11;  // the body's face 11 is not there
+  Baseline whole = Baseline::parse(text, "b.csv", objects);
+  EXPECT_THROW(whole.mark(f), InputError);
+  // As an OBJ group of a file, the body's ids are the file's: not bounded by its own count.
+  objects[1].group = "body";
+  Baseline group = Baseline::parse(text, "b.csv", objects);
+  EXPECT_NO_THROW(group.mark(f));
 }
 
 TEST(Baseline, FacesInEitherOrderAreOnePair) {
@@ -120,20 +197,20 @@ TEST(Baseline, FacesInEitherOrderAreOnePair) {
   baseline.mark(two);
   EXPECT_TRUE(one.pairs[0].accepted);
   EXPECT_TRUE(two.pairs[0].accepted);
-  EXPECT_EQ(baseline.use(), (BaselineUse{2, 2, 0}));
+  EXPECT_EQ(baseline.use(), expected_use(2, 2, {}));
 }
 
 TEST(Baseline, AStarFrameAcceptsThePairInEveryFrame) {
   Baseline baseline =
       Baseline::parse("frame,face_a,face_b,kind\n*,5,6,crossing\n8,1,2,\n", "b.csv", {});
-  EXPECT_EQ(baseline.use(), (BaselineUse{2, 0, 0}));  // nothing checked yet
+  EXPECT_EQ(baseline.use(), expected_use(2, 0, {}));  // nothing checked yet
   for (int64_t number : {-3, 0, 8, 1000000}) {
     FrameRecord f = frame_with(number, {{5, 6, kCrossing}, {1, 2, kCrossing}});
     baseline.mark(f);
     EXPECT_TRUE(f.pairs[0].accepted) << number;
     EXPECT_EQ(f.pairs[1].accepted, number == 8) << number;
   }
-  EXPECT_EQ(baseline.use(), (BaselineUse{2, 2, 0}));
+  EXPECT_EQ(baseline.use(), expected_use(2, 2, {}));
 }
 
 TEST(Baseline, ATouchingEntryAcceptsitsPairOnlyWhileItTouches) {
@@ -151,7 +228,9 @@ TEST(Baseline, ATouchingEntryAcceptsitsPairOnlyWhileItTouches) {
     EXPECT_EQ(f.pairs[0].accepted, kind == kTouching);
     EXPECT_TRUE(f.pairs[1].accepted && f.pairs[2].accepted && f.pairs[3].accepted);
     // A touching pair that crosses now leaves its entry unmatched: it got worse.
-    EXPECT_EQ(baseline.use(), (BaselineUse{4, 4, kind == kCrossing ? 1 : 0}));
+    EXPECT_EQ(
+        baseline.use(),
+        expected_use(4, 4, kind == kCrossing ? std::vector<int64_t>{2} : std::vector<int64_t>{}));
   }
   // Without a kind column every entry accepts either kind.
   Baseline kindless = Baseline::parse("frame,face_a,face_b\n1,0,1\n", "b.csv", {});
@@ -177,13 +256,13 @@ TEST(Baseline, AnEntryForAFrameAndForEveryFrameBothCount) {
   FrameRecord f = frame_with(4, {{0, 1, kCrossing}});
   baseline.mark(f);
   EXPECT_TRUE(f.pairs[0].accepted);
-  EXPECT_EQ(baseline.use(), (BaselineUse{2, 2, 1}));
+  EXPECT_EQ(baseline.use(), expected_use(2, 2, {2}));
   // Both accepting it: both matched.
   Baseline both = Baseline::parse("frame,face_a,face_b\n4,0,1\n*,0,1\n", "b.csv", {});
   FrameRecord g = frame_with(4, {{0, 1, kCrossing}});
   both.mark(g);
   EXPECT_TRUE(g.pairs[0].accepted);
-  EXPECT_EQ(both.use(), (BaselineUse{2, 2, 0}));
+  EXPECT_EQ(both.use(), expected_use(2, 2, {}));
 }
 
 TEST(Baseline, SceneRowsNameTheirObjectsAsThePairsCsvDoes) {
@@ -205,7 +284,7 @@ TEST(Baseline, SceneRowsNameTheirObjectsAsThePairsCsvDoes) {
   std::vector<bool> marks;
   for (const Pair& p : f.pairs) marks.push_back(p.accepted);
   EXPECT_EQ(marks, (std::vector<bool>{true, true, false, true, false}));
-  EXPECT_EQ(baseline.use(), (BaselineUse{3, 3, 0}));
+  EXPECT_EQ(baseline.use(), expected_use(3, 3, {}));
 }
 
 TEST(Baseline, LinesAreCountedThroughQuotedLineBreaksBlankLinesAndCrlf) {
@@ -245,7 +324,8 @@ TEST(Baseline, MalformedFilesAreRefusedWithTheirLine) {
       {"frame,face_a,face_b\n1,-2,3\n", 2, "face_a: expected a face id"},
       {"frame,face_a,face_b\n1,2,3.0\n", 2, "face_b: expected a face id"},
       {"frame,face_a,face_b\n1,2,4294967296\n", 2, "face_b: expected a face id"},
-      {"frame,face_a,face_b\n1,2, 3\n", 2, "face_b: expected a face id"},
+      {"frame,face_a,face_b\n1,2,3 4\n", 2, "face_b: expected a face id"},
+      {"frame;face_a;face_b\n1;2;3\n", 1, "no frame column in the header 'frame;face_a;face_b'"},
       {"frame,face_a,face_b\nall,2,3\n", 2, "frame: expected a frame number or *"},
       {"frame,face_a,face_b\n1,2,3\n1,4,4\n", 3, "face 4 paired with itself"},
       {"frame,face_a,face_b,kind\n1,2,3,cross\n", 2, "kind: expected crossing, touching or *"},
@@ -298,6 +378,17 @@ TEST(Baseline, ReadsAFileAndNamesOneThatCannotBeRead) {
   const std::filesystem::path path = tmp.path() / "accepted.csv";
   std::ofstream(path) << "frame,face_a,face_b\n1,2,3\n";
   EXPECT_EQ(Baseline::read(path, {}).entries(), 1);
+  // Without a final line end, and a header alone (which accepts nothing).
+  EXPECT_EQ(Baseline::parse("frame,face_a,face_b\n1,2,3", "b.csv", {}).entries(), 1);
+  EXPECT_EQ(Baseline::parse("frame,face_a,face_b\n", "b.csv", {}).entries(), 0);
+  try {
+    Baseline::read(tmp.path(), {});
+    ADD_FAILURE() << "a directory was read as a baseline";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a directory; expected a pairs.csv file"),
+              std::string::npos)
+        << e.what();
+  }
   try {
     Baseline::read(tmp.path() / "missing.csv", {});
     ADD_FAILURE() << "a missing baseline was read";

@@ -512,7 +512,7 @@ TEST(ReportStream, BaselineRunMatchesTheWholeReportWriters) {
       for (size_t i = 0; i < inputs.objects.size(); ++i)
         inputs.objects[i].name = "object" + std::to_string(i);
     }
-    inputs.baseline = {120, 90, 7};
+    inputs.baseline = {120, 3, 90, 2, {5, 17}};
     std::vector<FrameRecord> frames =
         scene ? random_scene_frames(7, 30, inputs.objects) : random_frames(7, 30);
     for (FrameRecord& f : frames) f.file = "cache/cloth." + std::to_string(f.frame) + ".obj";
@@ -547,10 +547,12 @@ TEST(ReportStream, BaselineRunMatchesTheWholeReportWriters) {
 
     const auto j = nlohmann::json::parse(read_all(tmp.path() / "report.json"));
     EXPECT_EQ(j.at("settings").at("baseline"), *settings.baseline);
-    EXPECT_EQ(
-        j.at("inputs").at("baseline"),
-        nlohmann::json(
-            {{"file", *settings.baseline}, {"entries", 120}, {"checked", 90}, {"unmatched", 7}}));
+    EXPECT_EQ(j.at("inputs").at("baseline"), nlohmann::json({{"file", *settings.baseline},
+                                                             {"entries", 120},
+                                                             {"left_out", 3},
+                                                             {"checked", 90},
+                                                             {"unmatched", 2},
+                                                             {"unmatched_lines", {5, 17}}}));
     for (size_t i = 0; i < frames.size(); ++i) {
       const auto& record = j.at("frames").at(i);
       int64_t marked = 0;
@@ -568,6 +570,9 @@ TEST(ReportStream, BaselineRunMatchesTheWholeReportWriters) {
     EXPECT_EQ(summary.at("frames_with_new_pairs"), streamed.frames_with_new_pairs);
     ASSERT_TRUE(streamed.first_new_frame.has_value());
     EXPECT_EQ(summary.at("first_new_frame"), *streamed.first_new_frame);
+    ASSERT_TRUE(streamed.first_failing_frame.has_value());  // fail_on any: the first new pair
+    EXPECT_EQ(summary.at("first_failing_frame"), *streamed.first_failing_frame);
+    EXPECT_EQ(streamed.first_failing_frame, streamed.first_new_frame);
     EXPECT_EQ(summary.at("failed"), streamed.pairs > streamed.accepted);
 
     // The same frames without a baseline: no accepted column or member at all.
@@ -854,7 +859,7 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
   int64_t with_crossings = 0, with_pairs = 0, pairs = 0, crossing = 0, degenerate = 0;
   int64_t uncertain = 0, confirmed = 0, topology = 0, reused = 0;
   int64_t accepted = 0, accepted_crossing = 0, with_new = 0;
-  std::optional<int64_t> first_new;
+  std::optional<int64_t> first_new, first_failing;
   double check = 0, read = 0, max_depth = 0;
   std::optional<size_t> worst;
   std::tuple<int64_t, int64_t, int64_t> worst_key{-1, -1, 0};
@@ -873,6 +878,12 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
       with_new += 1;
       if (!first_new) first_new = f.frame;
     }
+    int64_t frame_new_crossing = 0;
+    for (const Pair& p : f.pairs) frame_new_crossing += !p.accepted && p.kind == PairKind::crossing;
+    const bool fails = fail_on == FailOn::crossing ? frame_new_crossing > 0
+                       : fail_on == FailOn::any    ? frame_accepted < frame_pairs
+                                                   : false;
+    if (fails && !first_failing) first_failing = f.frame;
     with_crossings += frame_crossing > 0;
     with_pairs += frame_pairs > 0;
     pairs += frame_pairs;
@@ -908,6 +919,7 @@ void expect_brute_force_summary(const std::vector<FrameRecord>& frames, size_t n
   EXPECT_EQ(s.accepted_crossing, accepted_crossing);
   EXPECT_EQ(s.frames_with_new_pairs, with_new);
   EXPECT_EQ(s.first_new_frame, first_new);
+  EXPECT_EQ(s.first_failing_frame, first_failing);
   EXPECT_DOUBLE_EQ(s.check_seconds, check);
   EXPECT_DOUBLE_EQ(s.read_seconds, read);
   EXPECT_EQ(s.worst_frame, worst);
@@ -935,8 +947,8 @@ TEST(SummaryAccumulator, MatchesABruteForceRecountAfterEveryFrame) {
     // Ties for the worst frame: the same counts again later must not take its place.
     frames[40].pairs = frames[20].pairs;
     frames[41].pairs = frames[20].pairs;
-    // Seeds 13 and 14: a baseline's marks, on every pair of most frames (which then have no new
-    // pair) and on some pairs of the others.
+    // Seeds 13 and 14: a baseline's marks, on every pair of about half the frames (which then
+    // have no new pair) and on some pairs of the others.
     if (seed >= 13) accept_at_random(frames, seed);
     for (FailOn fail_on : {FailOn::crossing, FailOn::any, FailOn::none}) {
       SummaryAccumulator accumulator(fail_on);

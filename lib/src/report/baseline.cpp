@@ -69,7 +69,13 @@ class CsvRecords {
     } else {
       const size_t end = text_.find_first_of(",\r\n\"", at_);
       const size_t stop = end == std::string_view::npos ? text_.size() : end;
-      field.append(text_.substr(at_, stop - at_));
+      // Spaces around a value typed by hand ("frame, face_a") are not part of it.
+      std::string_view value = text_.substr(at_, stop - at_);
+      while (!value.empty() && (value.front() == ' ' || value.front() == '\t'))
+        value.remove_prefix(1);
+      while (!value.empty() && (value.back() == ' ' || value.back() == '\t'))
+        value.remove_suffix(1);
+      field.append(value);
       at_ = stop;
       if (at_ < text_.size() && text_[at_] == '"')
         throw InputError(name_, line_, "a quote inside an unquoted field (quote the whole field)");
@@ -115,15 +121,23 @@ std::string in_quotes(const std::string& text) {
 
 /// The columns a baseline is read by (header positions; -1 when absent).
 struct Columns {
-  int frame = -1, face_a = -1, face_b = -1, kind = -1, object_a = -1, object_b = -1;
+  int frame = -1, face_a = -1, face_b = -1, kind = -1, object_a = -1, object_b = -1, accepted = -1;
 };
+
+/// The header's fields joined as they were read, for a message about it.
+std::string header_text(const std::vector<std::string>& header) {
+  std::string text;
+  for (const std::string& field : header) text += (text.empty() ? "" : ",") + field;
+  return text;
+}
 
 Columns columns_of(const std::vector<std::string>& header, const std::string& name, int64_t line,
                    bool scene) {
   Columns c;
   const std::pair<const char*, int*> wanted[] = {
-      {"frame", &c.frame}, {"face_a", &c.face_a},     {"face_b", &c.face_b},
-      {"kind", &c.kind},   {"object_a", &c.object_a}, {"object_b", &c.object_b}};
+      {"frame", &c.frame},      {"face_a", &c.face_a},     {"face_b", &c.face_b},
+      {"kind", &c.kind},        {"object_a", &c.object_a}, {"object_b", &c.object_b},
+      {"accepted", &c.accepted}};
   for (int i = 0; i < static_cast<int>(header.size()); ++i)
     for (const auto& [column, at] : wanted)
       if (header[i] == column) {
@@ -134,8 +148,9 @@ Columns columns_of(const std::vector<std::string>& header, const std::string& na
   for (const auto& [column, at] : {wanted[0], wanted[1], wanted[2]})
     if (*at < 0)
       throw InputError(name, line,
-                       std::string("no ") + column +
-                           " column: a baseline is a pairs.csv, its header "
+                       std::string("no ") + column + " column in the header " +
+                           in_quotes(header_text(header)) +
+                           ": a baseline is a pairs.csv, comma-separated, its header "
                            "frame,face_a,face_b,kind,... (the columns in any order)");
   const bool objects_named = c.object_a >= 0 || c.object_b >= 0;
   if (objects_named && (c.object_a < 0 || c.object_b < 0))
@@ -156,6 +171,9 @@ Columns columns_of(const std::vector<std::string>& header, const std::string& na
 }  // namespace
 
 Baseline Baseline::read(const std::filesystem::path& path, std::span<const ObjectInput> objects) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error))
+    throw InputError(path.string(), 0, "a directory; expected a pairs.csv file");
   return parse(io::read_file_bytes(path), path.string(), objects);
 }
 
@@ -167,21 +185,37 @@ Baseline Baseline::parse(std::string_view text, const std::string& name,
     throw InputError(name, 0, "empty: a baseline is a pairs.csv, its header first");
   const int64_t header_line = records.line();
   const Columns c = columns_of(fields, name, header_line, !objects.empty());
+  // Optional columns past a row's end are empty: a row cut by hand may stop before them.
   const size_t needed =
-      static_cast<size_t>(std::max({c.frame, c.face_a, c.face_b, c.kind, c.object_a, c.object_b})) +
-      1;
+      static_cast<size_t>(std::max({c.frame, c.face_a, c.face_b, c.object_a, c.object_b})) + 1;
+  const auto optional_field = [&](int column) -> const std::string& {
+    static const std::string empty;
+    return column >= 0 && static_cast<size_t>(column) < fields.size() ? fields[column] : empty;
+  };
   std::unordered_map<std::string, int32_t> object_index;
   for (size_t i = 0; i < objects.size(); ++i)
     object_index.emplace(objects[i].name, static_cast<int32_t>(i));
 
   Baseline baseline;
+  baseline.name_ = name;
+  baseline.whole_file_.assign(std::max<size_t>(objects.size(), 1), true);
+  for (size_t i = 0; i < objects.size(); ++i) baseline.whole_file_[i] = !objects[i].group;
   std::vector<Entry> every_frame;
   while (records.next(fields)) {
     const int64_t line = records.line();
     if (fields.size() < needed)
       throw InputError(name, line,
                        "only " + std::to_string(fields.size()) +
-                           " fields; the header's columns need " + std::to_string(needed));
+                           " fields; the header's frame, face and object columns need " +
+                           std::to_string(needed));
+    const std::string& accepted = optional_field(c.accepted);
+    if (accepted == "0") {
+      ++baseline.left_out_;
+      continue;
+    }
+    if (accepted != "1" && !accepted.empty())
+      throw InputError(name, line,
+                       "accepted: expected 1, 0 or nothing, got " + in_quotes(accepted));
     const auto face = [&](int column, const char* what) {
       const std::optional<int32_t> id = whole_number<int32_t>(fields[column]);
       if (!id || *id < 0)
@@ -203,6 +237,7 @@ Baseline Baseline::parse(std::string_view text, const std::string& name,
       return found->second;
     };
     Entry e;
+    e.line = line;
     const std::string& frame = fields[c.frame];
     const bool every = frame == "*";
     if (!every) {
@@ -224,14 +259,12 @@ Baseline Baseline::parse(std::string_view text, const std::string& name,
     if (e.object_a == e.object_b && e.a == e.b)
       throw InputError(name, line,
                        "face " + std::to_string(e.a) + " paired with itself (face_a = face_b)");
-    if (c.kind >= 0) {
-      const std::string& kind = fields[c.kind];
-      if (kind == "touching")
-        e.crossing_accepted = false;
-      else if (kind != "crossing" && kind != "*" && !kind.empty())
-        throw InputError(name, line,
-                         "kind: expected crossing, touching or * (either), got " + in_quotes(kind));
-    }
+    const std::string& kind = optional_field(c.kind);
+    if (kind == "touching")
+      e.crossing_accepted = false;
+    else if (kind != "crossing" && kind != "*" && !kind.empty())
+      throw InputError(name, line,
+                       "kind: expected crossing, touching or * (either), got " + in_quotes(kind));
     (every ? every_frame : baseline.entries_).push_back(e);
   }
 
@@ -246,6 +279,7 @@ Baseline Baseline::parse(std::string_view text, const std::string& name,
     for (size_t i = 0; i < entries.size(); ++i) {
       if (kept > 0 && key(entries[kept - 1]) == key(entries[i])) {
         entries[kept - 1].crossing_accepted |= entries[i].crossing_accepted;
+        entries[kept - 1].line = std::min(entries[kept - 1].line, entries[i].line);
         continue;
       }
       entries[kept++] = entries[i];
@@ -267,8 +301,26 @@ void Baseline::mark(FrameRecord& frame) {
   const auto last =
       std::upper_bound(first, per_frame_end, frame.frame,
                        [](int64_t number, const Entry& e) { return number < e.frame; });
-  for (auto e = first; e != last; ++e) e->checked = true;
-  for (auto e = per_frame_end; e != entries_.end(); ++e) e->checked = true;
+  // An entry's faces must be faces of the frame it is for (where their count is known).
+  const auto triangles_of = [&](int32_t object) -> int64_t {
+    if (static_cast<size_t>(object) >= whole_file_.size() || !whole_file_[object]) return -1;
+    if (frame.objects.empty()) return object == 0 ? frame.triangles : -1;
+    return static_cast<size_t>(object) < frame.objects.size() ? frame.objects[object].triangles
+                                                              : -1;
+  };
+  const auto check = [&](Entry& e) {
+    e.checked = true;
+    for (const auto& [object, face] : {std::pair{e.object_a, e.a}, std::pair{e.object_b, e.b}})
+      if (const int64_t count = triangles_of(object); count >= 0 && face >= count)
+        throw InputError(
+            name_, e.line,
+            "face " + std::to_string(face) + " is not a face of frame " +
+                std::to_string(frame.frame) + " (" + std::to_string(count) + " triangles" +
+                (frame.objects.empty() ? "" : " in its object " + std::to_string(object)) +
+                "): is the baseline for another mesh?");
+  };
+  for (auto e = first; e != last; ++e) check(*e);
+  for (auto e = per_frame_end; e != entries_.end(); ++e) check(*e);
   // The entry of `pair` in [begin, end) (sorted by pair), if it accepts the pair as it is now.
   const auto accepts = [](auto begin, auto end, const Pair& p) {
     auto object_a = p.object_a, a = p.a, object_b = p.object_b, b = p.b;
@@ -296,10 +348,13 @@ void Baseline::mark(FrameRecord& frame) {
 BaselineUse Baseline::use() const {
   BaselineUse use;
   use.entries = entries();
+  use.left_out = left_out_;
   for (const Entry& e : entries_) {
     use.checked += e.checked;
-    use.unmatched += e.checked && !e.matched;
+    if (e.checked && !e.matched) use.unmatched_lines.push_back(e.line);
   }
+  use.unmatched = static_cast<int64_t>(use.unmatched_lines.size());
+  std::sort(use.unmatched_lines.begin(), use.unmatched_lines.end());
   return use;
 }
 

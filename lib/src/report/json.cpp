@@ -188,6 +188,8 @@ ordered_json summary_json(const Report& run, const Summary& s) {
     j["new_crossing"] = s.crossing - s.accepted_crossing;
     j["frames_with_new_pairs"] = s.frames_with_new_pairs;
     j["first_new_frame"] = s.first_new_frame ? ordered_json(*s.first_new_frame) : nullptr;
+    j["first_failing_frame"] =
+        s.first_failing_frame ? ordered_json(*s.first_failing_frame) : nullptr;
   }
   j["builds"] = run.builds;
   j["rebuilds"] = run.rebuilds;
@@ -383,8 +385,10 @@ void write_report_json_tail(std::ostream& out, const Report& run, const Summary&
         << member("baseline",
                   {{"file", *run.settings.baseline},
                    {"entries", use.entries},
+                   {"left_out", use.left_out},
                    {"checked", use.checked},
-                   {"unmatched", use.unmatched}},
+                   {"unmatched", use.unmatched},
+                   {"unmatched_lines", use.unmatched_lines}},
                   2);
   }
   out << "\n";

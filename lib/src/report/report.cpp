@@ -149,17 +149,12 @@ void SummaryAccumulator::add(const FrameRecord& frame) {
     s.worst_frame = position;
     s.worst = WorstFrame{frame.frame, frame.file, crossing, pairs};
   }
-  switch (fail_on_) {
-    case FailOn::crossing:
-      s.failed = s.crossing > s.accepted_crossing;
-      break;
-    case FailOn::any:
-      s.failed = s.pairs > s.accepted;
-      break;
-    case FailOn::none:
-      s.failed = false;
-      break;
-  }
+  const int64_t new_crossing = crossing - frame.accepted_crossing_count();
+  const bool frame_fails = fail_on_ == FailOn::crossing ? new_crossing > 0
+                           : fail_on_ == FailOn::any    ? accepted < pairs
+                                                        : false;
+  if (frame_fails && !s.first_failing_frame) s.first_failing_frame = frame.frame;
+  s.failed = s.first_failing_frame.has_value();
 }
 
 Summary summarize(const Report& report) {

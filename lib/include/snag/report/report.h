@@ -178,9 +178,11 @@ struct ObjectInput {
 
 /// What a run made of its baseline (report.json's inputs.baseline), from Baseline::use().
 struct BaselineUse {
-  int64_t entries = 0;    ///< distinct pairs the file lists
+  int64_t entries = 0;    ///< distinct pairs the file accepts
+  int64_t left_out = 0;   ///< rows marked accepted 0 (new pairs of the run that wrote it)
   int64_t checked = 0;    ///< entries of the frames checked, every-frame entries included
   int64_t unmatched = 0;  ///< of those, entries that accepted no pair
+  std::vector<int64_t> unmatched_lines;  ///< their lines in the file (an entry's first), sorted
   friend bool operator==(const BaselineUse&, const BaselineUse&) = default;
 };
 
@@ -236,6 +238,9 @@ struct Summary {
   int64_t accepted_crossing = 0;
   int64_t frames_with_new_pairs = 0;
   std::optional<int64_t> first_new_frame;  ///< number of the first frame added with a new pair
+  /// Number of the first frame added that fails the run under fail_on (a new crossing pair, or
+  /// with `any` a new pair); nullopt while the run has not failed.
+  std::optional<int64_t> first_failing_frame;
   int64_t degenerate = 0;
   int64_t uncertain_tests = 0;
   int64_t confirmed_pairs = 0;
