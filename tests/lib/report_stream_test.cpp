@@ -801,6 +801,26 @@ TEST(ReportStream, FullDiskIsAWriteErrorAndLeavesNoFile) {
   }
 }
 
+// A failed write loses the run: an add() after it says so, rather than finish() once every
+// frame was checked (an hour later). More frames than write_ahead, so that an add() waits for
+// the failed write.
+TEST(ReportStream, AFailedWriteStopsTheRunAtALaterAdd) {
+  TempDir tmp;
+  FrameRecord big = small_frames()[1];  // about 0.5 MB of pairs.csv rows, past the limit
+  for (int32_t a = 0; a < 20000; ++a) big.pairs.push_back({a, a + 1, PairKind::touching, a, a});
+  FileSizeLimit limit(64 * 1024);
+  ReportStream stream(tmp.path(), "1.2.3", small_settings(), {}, 1);
+  try {
+    for (size_t k = 0; k < 2 * ReportStream::write_ahead + 2; ++k) {
+      big.frame = 10 + static_cast<int64_t>(k);
+      stream.add(big);
+    }
+    ADD_FAILURE() << "every add() returned after a failed write";
+  } catch (const WriteError& e) {
+    EXPECT_NE(std::string(e.what()).find("write failed"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ReportStream, UnusableDirectoryFailsAtOnce) {
   TempDir tmp;
   std::ofstream(tmp.path() / "a-file") << "x";
@@ -809,6 +829,18 @@ TEST(ReportStream, UnusableDirectoryFailsAtOnce) {
                WriteError);
   EXPECT_EQ(entries(tmp.path()), std::vector<std::string>{"a-file"});
   EXPECT_EQ(read_all(tmp.path() / "a-file"), "x");
+  // A directory in which nobody, root included, can create a file (/proc/self/fdinfo, Linux):
+  // the stream fails as it starts, naming the first report it could not create.
+  const fs::path no_files = "/proc/self/fdinfo";
+  if (fs::is_directory(no_files)) {
+    try {
+      ReportStream stream(no_files, "1.2.3", small_settings());
+      ADD_FAILURE() << "the stream started in " << no_files;
+    } catch (const WriteError& e) {
+      EXPECT_EQ(e.path(), no_files / "pairs.csv");
+      EXPECT_NE(std::string(e.what()).find("cannot create"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ReportStream, FramesOutOfOrderOrAfterFinishAreInternalErrors) {

@@ -161,6 +161,29 @@ TEST_F(SequenceDir, GlobsNumberFilesByTheirLastDigits) {
   EXPECT_EQ(names(resolve_sequence(at("*f9*"))), (Names{{9, "take2_f9.obj"}}));
 }
 
+// Glob brackets as fnmatch(3) reads them (the expected sets are glibc's fnmatch with
+// FNM_NOESCAPE on these names): negation by ! or ^, a ] first in a class is a member, a range
+// holds both its ends, a - last is a member, an unclosed [ is itself, and a * may match nothing.
+TEST_F(SequenceDir, GlobBracketsAndStarsMatchAsFnmatchDoes) {
+  touch({"va_1.obj", "vc_2.obj", "vd_3.obj", "v]_4.obj", "v[_5.obj", "v^_6.obj", "v-_7.obj",
+         "v9_8.obj", "v0_9.obj", "v!_10.obj"});
+  const auto numbers = [&](const std::string& glob) {
+    std::vector<int64_t> out;
+    for (const Frame& f : resolve_sequence(at(glob))) out.push_back(f.number);
+    return out;
+  };
+  using Numbers = std::vector<int64_t>;
+  EXPECT_EQ(numbers("v[!a]_*"), (Numbers{2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(numbers("v[^a]_*"), (Numbers{2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(numbers("v[]]_*"), (Numbers{4}));
+  EXPECT_EQ(numbers("v[!]]_*"), (Numbers{1, 2, 3, 5, 6, 7, 8, 9, 10}));
+  EXPECT_EQ(numbers("v[a-c]_*"), (Numbers{1, 2}));
+  EXPECT_EQ(numbers("v[0-9]_*"), (Numbers{8, 9}));
+  EXPECT_EQ(numbers("v[a-]_*"), (Numbers{1, 7}));
+  EXPECT_EQ(numbers("v[_*"), (Numbers{5}));
+  EXPECT_EQ(numbers("vc_2.obj*"), (Numbers{2}));
+}
+
 TEST_F(SequenceDir, NothingMatchedNamesThePattern) {
   touch({"dress.001.obj"});
   for (const std::string& spec : {at("dress.%04d.obj"), at("dress.*.ply"), at("nothing.obj")}) {
@@ -172,7 +195,15 @@ TEST_F(SequenceDir, NothingMatchedNamesThePattern) {
       EXPECT_EQ(std::string(e.what()).rfind(spec + ": ", 0), 0u) << e.what();
     }
   }
-  EXPECT_THROW(resolve_sequence((dir_ / "missing_dir" / "f.%04d.obj").string()), InputError);
+  const fs::path missing = dir_ / "missing_dir";
+  try {
+    resolve_sequence((missing / "f.%04d.obj").string());
+    ADD_FAILURE() << "a pattern in a missing directory resolved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("directory '" + missing.string() + "' does not exist"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // The same with only two files: one numbered frame and one without digits.
@@ -208,6 +239,16 @@ TEST_F(SequenceDir, AFileWithoutDigitsAmongFramesIsAnError) {
   EXPECT_EQ(names(resolve_sequence((dir_ / "alone").string())), (Names{{0, "body.obj"}}));
 }
 
+// Frames named by their number alone (1.obj, 2.obj, 10.obj): the digits begin the name, and
+// every one of them counts, in a directory, a glob and a pattern alike.
+TEST_F(SequenceDir, FramesNamedByTheirNumberAlone) {
+  touch({"1.obj", "2.obj", "10.obj"});
+  const Names expected{{1, "1.obj"}, {2, "2.obj"}, {10, "10.obj"}};
+  EXPECT_EQ(names(resolve_sequence(dir_.string())), expected);
+  EXPECT_EQ(names(resolve_sequence(at("*.obj"))), expected);
+  EXPECT_EQ(names(resolve_sequence(at("%d.obj"))), expected);
+}
+
 TEST_F(SequenceDir, APatternMatchingNothingNamesAFileOfAnotherWidth) {
   touch({"drape.0001.obj", "drape.0002.obj", "coat.12.obj", "other.0001.ply"});
   const auto message = [&](const std::string& spec) -> std::string {
@@ -233,10 +274,33 @@ TEST_F(SequenceDir, APatternMatchingNothingNamesAFileOfAnotherWidth) {
   EXPECT_EQ(message("other.@@.obj").find("has its frame number"), std::string::npos);
 }
 
+// The hint needs digits where the token goes: "hat..obj" has none (nothing to hint at), and
+// "coat.0.obj" is frame 0 unpadded, not a number padded to one digit.
+TEST_F(SequenceDir, AnOtherWidthHintNeedsAFrameNumberWhereTheTokenGoes) {
+  touch({"hat..obj", "coat.0.obj"});
+  const auto message = [&](const std::string& spec) -> std::string {
+    try {
+      resolve_sequence(at(spec));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "resolved";
+  };
+  EXPECT_EQ(message("hat.%04d.obj").find("has its frame number"), std::string::npos)
+      << message("hat.%04d.obj");
+  EXPECT_NE(message("coat.%04d.obj")
+                .find("'coat.0.obj' has its frame number unpadded: write %d, # or $F"),
+            std::string::npos)
+      << message("coat.%04d.obj");
+}
+
 TEST_F(SequenceDir, BadPatternsAreUsageErrors) {
   EXPECT_THROW(resolve_sequence(""), UsageError);
   EXPECT_THROW(resolve_sequence(at("a.%04d.%04d.obj")), UsageError);
   EXPECT_THROW(resolve_sequence(at("a_####_*.obj")), UsageError);
+  // Each of the glob characters, in the prefix as in the suffix.
+  EXPECT_THROW(resolve_sequence(at("a_####_[ab].obj")), UsageError);
+  EXPECT_THROW(resolve_sequence(at("a?_%04d.obj")), UsageError);
 }
 
 TEST(FrameNumber, LastRunOfDigitsInTheStem) {
@@ -245,6 +309,7 @@ TEST(FrameNumber, LastRunOfDigitsInTheStem) {
   EXPECT_EQ(frame_number_from_name("v2/body.obj"), 0);
   EXPECT_EQ(frame_number_from_name("a12b34c.ply"), 34);
   EXPECT_EQ(frame_number_from_name("frame.obj2"), 0);  // digits of the extension do not count
+  EXPECT_EQ(frame_number_from_name("cache/1001.obj"), 1001);  // a name of digits alone
   EXPECT_THROW(frame_number_from_name("f99999999999999999999.obj"), InputError);
 }
 

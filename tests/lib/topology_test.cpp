@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "snag/detect/topology.h"
+#include "snag/error.h"
 
 namespace snag::detect {
 namespace {
@@ -176,6 +177,69 @@ TEST(Topology, OwnershipWithoutAFramesDegenerateTrianglesMatchesBruteForce) {
       }
     }
   }
+}
+
+// A vertex used by exactly kMaxListedValence triangles is listed, one used by one more is not:
+// closed fans of 32 triangles around vertex 0 and of 33 around vertex 33.
+TEST(Topology, AVertexOfExactlyTheListedValenceIsListed) {
+  std::vector<geom::Tri> triangles;
+  const auto add_fan = [&](int32_t hub, int32_t k) {  // hub, then its ring hub + 1 .. hub + k
+    for (int32_t i = 0; i < k; ++i)
+      triangles.push_back(geom::Tri{{hub, hub + 1 + i, hub + 1 + (i + 1) % k}});
+  };
+  const int32_t k = Topology::kMaxListedValence;
+  add_fan(0, k);
+  add_fan(k + 1, k + 1);
+  const int32_t vertices = 2 * k + 3;
+  const Topology topo = make_topology(triangles, vertices);
+  EXPECT_EQ(topo.listed_vertex[0], 1);
+  EXPECT_EQ(topo.listed_vertex[k + 1], 0);
+  expect_matches_brute_force(triangles, vertices);
+}
+
+/// Two copies of one random mesh (20 vertices, 60 triangles) laid end to end as two parts.
+struct TwoParts {
+  std::vector<geom::Tri> one = random_mesh(20, 60, 0, 5);
+  std::vector<geom::Tri> both;
+  PartLayout layout;
+  TwoParts() {
+    both = one;
+    for (geom::Tri t : one) {
+      for (int32_t& v : t.v) v += 20;
+      both.push_back(t);
+    }
+    layout.triangle_begin = {0, 60, 120};
+    layout.vertex_begin = {0, 20, 40};
+  }
+};
+
+// A part not checked against itself lists no neighbour pairs (its pairs are never tested); a
+// part that is lists those of the mesh alone (brute force), moved to its triangles.
+TEST(Topology, OnlyPartsCheckedAgainstThemselvesListNeighbourPairs) {
+  const TwoParts m;
+  expect_matches_brute_force(m.one, 20);
+  const Topology alone = make_topology(m.one, 20);
+  const Topology scene = make_scene_topology(m.both, 40, m.layout, {{0, 1}, {1, 1}});
+  std::vector<std::array<int32_t, 2>> moved;
+  for (const auto& [a, b] : alone.neighbor_pairs) moved.push_back({a + 60, b + 60});
+  EXPECT_EQ(scene.neighbor_pairs, moved);
+  EXPECT_EQ(scene.neighbor_shared, alone.neighbor_shared);
+  ASSERT_EQ(scene.neighbor_begin.size(), 121u);
+  for (int32_t t = 0; t <= 60; ++t) EXPECT_EQ(scene.neighbor_begin[t], 0) << "triangle " << t;
+  for (int32_t t = 0; t <= 60; ++t)
+    EXPECT_EQ(scene.neighbor_begin[60 + t], alone.neighbor_begin[t]) << "triangle " << 60 + t;
+}
+
+// A check may name its two parts in either order; one naming a part that does not exist is
+// refused in either order; and the parts' vertices must be exactly the mesh's.
+TEST(Topology, SceneChecksAndLayoutsAreValidated) {
+  const TwoParts m;
+  const Topology topo = make_scene_topology(m.both, 40, m.layout, {{1, 0}, {1, 1}, {0, 1}});
+  EXPECT_EQ(topo.checks, (std::vector<PartCheck>{{0, 1}, {1, 1}}));
+  EXPECT_THROW(make_scene_topology(m.both, 40, m.layout, {{2, 0}}), InternalError);
+  EXPECT_THROW(make_scene_topology(m.both, 40, m.layout, {{1, -1}}), InternalError);
+  // One vertex more than the parts hold (no triangle uses it).
+  EXPECT_THROW(make_scene_topology(m.both, 41, m.layout, {{0, 0}}), InternalError);
 }
 
 TEST(Topology, EmptyAndAllDegenerateMeshes) {

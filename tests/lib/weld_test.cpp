@@ -94,6 +94,30 @@ TEST(Weld, NeighboursAcrossCellBoundariesAndTheOrigin) {
   EXPECT_EQ(weld_representatives(p, 0.0011), (Reps{0, 0, 2, 2}));
 }
 
+// Two points the tolerance apart as welding measures it, in doubles (0.1 - (-1e-18) rounds to
+// 0.1), on either side of the origin: cells as wide as the tolerance would put them two cells
+// apart (floor(-1e-18 / 0.1) = -1, floor(0.1 / 0.1) = 1), cells of twice it keep them neighbours.
+TEST(Weld, PointsTheToleranceApartAcrossTheOriginJoin) {
+  const std::vector<Vec3d> p = {{-1e-18, 0, 0}, {0.1, 0, 0}};
+  EXPECT_EQ(brute_force_representatives(p, 0.1), (Reps{0, 0}));
+  EXPECT_EQ(weld_representatives(p, 0.1), (Reps{0, 0}));
+}
+
+// Exporters write "-0.000000": a vertex at x = -0.0 must be found from the cell on its other
+// side as one at +0.0 is (a cell key of -0.0 would hash apart from the 0.0 that the neighbour's
+// lookup makes). Many pairs, so that a miss cannot hide in a shared hash bucket.
+TEST(Weld, NegativeZeroCoordinatesMeetTheirNeighbours) {
+  std::vector<Vec3d> p;
+  Reps expected;
+  for (int32_t i = 0; i < 200; ++i) {
+    p.push_back({-0.0, 3.0 * i, -0.0});
+    p.push_back({-0.05, 3.0 * i, 0.01});  // 0.051 away; the next pair is 3 away
+    expected.insert(expected.end(), {2 * i, 2 * i});
+  }
+  ASSERT_EQ(brute_force_representatives(p, 0.1), expected);
+  EXPECT_EQ(weld_representatives(p, 0.1), expected);
+}
+
 TEST(Weld, LargeCoordinatesWithATinyTolerance) {
   const std::vector<Vec3d> p = {
       {1e15, -1e15, 3}, {1e15, -1e15, 3 + 1e-6}, {1e15 + 0.125, -1e15, 3}, {1e15, -1e15, 3}};

@@ -144,6 +144,24 @@ TEST(CgalConfirmer, ContradictsPairsThatDoNotIntersectOrHaveTheOtherKind) {
   EXPECT_NE(found[1].what.find("no intersection"), std::string::npos) << found[1].what;
 }
 
+// The other way round: a pair said to cross that CGAL finds only touching (a corner resting on
+// the other face) is contradicted as touching.
+TEST(CgalConfirmer, NamesTouchingForAPairSaidToCrossThatOnlyTouches) {
+  const std::vector<geom::Vec3d> positions{{0, 0, 0}, {4, 0, 0}, {0, 4, 0},
+                                           {1, 1, 0}, {2, 1, 1}, {1, 2, 1}};
+  const std::vector<geom::Tri> triangles{{{0, 1, 2}}, {{3, 4, 5}}};
+  const detect::Topology topology = detect::make_topology(triangles, 6);
+  const detect::ExactContext context{positions, &topology};
+  auto confirmer = make_cgal_confirmer();
+  const std::vector<detect::FacePair> touching{{0, 1, detect::PairKind::touching}};
+  EXPECT_TRUE(confirmer->confirm(context, touching).empty());
+  const std::vector<detect::FacePair> crossing{{0, 1, detect::PairKind::crossing}};
+  const std::vector<detect::Disagreement> found = confirmer->confirm(context, crossing);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].pair, crossing[0]);
+  EXPECT_NE(found[0].what.find("CGAL finds a touching pair"), std::string::npos) << found[0].what;
+}
+
 TEST(CgalConfirmer, ADisagreementIsAnInternalErrorNamingThePair) {
   // A confirmer that contradicts everything stands in for a bug in snag's decisions.
   struct Contrary final : detect::PairConfirmer {
