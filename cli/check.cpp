@@ -484,15 +484,15 @@ int run_check(const CheckOptions& o) {
       resolved, *checker, sequence, scene_run, inputs,
       [&](report::FrameRecord&& record) {
         if (baseline) {
-          baseline->mark(record);
           // Baseline rows name faces by id, and ids mean other faces after the face list
-          // changed: said once, at the first such frame.
+          // changed: said once, at the first such frame (before its marks, which may fail).
           if (record.topology_changed && !topology_warned) {
             topology_warned = true;
             warn("frame " + std::to_string(record.frame) +
                  " has another face list than the frame before: the --baseline's face ids may "
                  "name other faces from there on");
           }
+          baseline->mark(record);
         }
         collapsed.note(record, warn);
         progress.update(reports.summary().frames_checked + 1,

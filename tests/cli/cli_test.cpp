@@ -645,6 +645,25 @@ TEST(CliBaseline, HandWrittenRowsForEveryFrameAndByKind) {
   EXPECT_NE(touching.out.find("2 entries, 2 for the frames checked, 1 matched no pair (line 2)\n"),
             std::string::npos)
       << touching.out;
+
+  // Six entries that match nothing: the first five lines are named. A fourth frame puts the
+  // faces back in frame 1's order, a second change of the face list, warned of once only.
+  write_text(tmp.path() / "seq" / "f.0004.obj",
+             std::string(quad_vertices) + b_away + "f 1 2 3 4\nf 5 6 7\n");
+  write_text(tmp.path() / "stale.csv",
+             "frame,face_a,face_b\n3,0,1\n3,0,2\n3,1,2\n2,0,1\n2,1,2\n4,0,1\n");
+  const RunResult stale = run_snag({"check", "seq", "--baseline", "stale.csv"}, tmp.path());
+  EXPECT_EQ(stale.status, 1) << context(stale);
+  EXPECT_NE(stale.out.find("6 entries, 6 for the frames checked, 6 matched no pair (lines 2, 3, "
+                           "4, 5, 6, ...)\n"),
+            std::string::npos)
+      << stale.out;
+  const std::string warning = "has another face list than the frame before";
+  const size_t at = stale.err.find(warning);
+  EXPECT_NE(at, std::string::npos) << stale.err;
+  EXPECT_EQ(stale.err.find(warning, at + 1), std::string::npos) << stale.err;
+  EXPECT_NE(stale.err.find("[4/4] frame 4: clean (topology changed)"), std::string::npos)
+      << stale.err;
 }
 
 TEST(CliBaseline, ABadBaselineExitsThreeBeforeAnyFrameAndWritesNoReport) {

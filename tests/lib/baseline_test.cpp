@@ -115,12 +115,16 @@ TEST(Baseline, ColumnsAreFoundByNameInAnyOrderAndOthersIgnored) {
       "note, face_b ,kind,frame,face_a\n"
       "\"seam, left\",12,crossing,40,11\n"
       "button, 30 ,touching, 40,2\n"
-      "cut short,7\t,\t, 40 ,3\n",
+      "cut short,7\t,\t, 40 ,3\n"
+      "\t\"tabbed\", 50 ,crossing,\t40\t, 2\n",
       "b.csv", {});
   FrameRecord f = frame_with(
       40, {{11, 12, kCrossing}, {2, 30, kTouching}, {2, 31, kTouching}, {3, 7, kCrossing}});
   baseline.mark(f);
   EXPECT_EQ(accepted_of(f), (std::set<std::pair<int32_t, int32_t>>{{11, 12}, {2, 30}, {3, 7}}));
+  FrameRecord tabbed = frame_with(40, {{2, 50, kCrossing}});
+  baseline.mark(tabbed);
+  EXPECT_TRUE(tabbed.pairs[0].accepted);
   Baseline short_rows = Baseline::parse("frame,face_a,face_b,kind,poly_a\n40,3,7\n", "b.csv", {});
   FrameRecord g = frame_with(40, {{3, 7, kCrossing}});
   short_rows.mark(g);
@@ -164,11 +168,26 @@ TEST(Baseline, AFacePastTheFramesTrianglesIsAnErrorWithItsLine) {
               std::string::npos)
         << e.what();
   }
-  // An every-frame entry is bounded by every frame.
-  Baseline every = Baseline::parse("frame,face_a,face_b\n*,3,40\n", "mine.csv", {});
+  // An every-frame entry is bounded by every frame, up to the first whose face list changed:
+  // its ids were found in one face list, and a later one may have fewer faces.
+  Baseline every = Baseline::parse("frame,face_a,face_b\n*,3,40\n12,3,40\n", "mine.csv", {});
   FrameRecord small = frame_with(9, {});
   small.triangles = 40;
   EXPECT_THROW(every.mark(small), InputError);
+  Baseline later = Baseline::parse("frame,face_a,face_b\n*,3,40\n12,3,40\n", "mine.csv", {});
+  FrameRecord first = frame_with(9, {{3, 40, kCrossing}});
+  later.mark(first);
+  EXPECT_TRUE(first.pairs[0].accepted);
+  for (const bool changed : {true, false}) {  // the change, then a frame after it
+    FrameRecord fewer = frame_with(changed ? 10 : 11, {});
+    fewer.triangles = 40;
+    fewer.topology_changed = changed;
+    EXPECT_NO_THROW(later.mark(fewer));
+  }
+  // An entry for one frame still is.
+  FrameRecord twelve = frame_with(12, {});
+  twelve.triangles = 40;
+  EXPECT_THROW(later.mark(twelve), InputError);
 }
 
 TEST(Baseline, SceneFacesAreBoundedByTheirObjectUnlessItIsAGroup) {
@@ -181,11 +200,35 @@ TEST(Baseline, SceneFacesAreBoundedByTheirObjectUnlessItIsAGroup) {
   f.objects[0].triangles = 20;
   f.objects[1].triangles = 11;  // the body's face 11 is not there
   Baseline whole = Baseline::parse(text, "b.csv", objects);
-  EXPECT_THROW(whole.mark(f), InputError);
+  try {
+    whole.mark(f);
+    ADD_FAILURE() << "the body's face 11 was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("face 11 is not a face of frame 1 (body, \"v2\": 11 "
+                                         "triangles)"),
+              std::string::npos)
+        << e.what();
+  }
+  // Either face of a row: here the dress's (object_a), past its 20.
+  Baseline dress =
+      Baseline::parse("frame,face_a,face_b,object_a,object_b\n1,25,0,dress,\"body, \"\"v2\"\"\"\n",
+                      "b.csv", objects);
+  EXPECT_THROW(dress.mark(f), InputError);
   // As an OBJ group of a file, the body's ids are the file's: not bounded by its own count.
   objects[1].group = "body";
   Baseline group = Baseline::parse(text, "b.csv", objects);
   EXPECT_NO_THROW(group.mark(f));
+}
+
+TEST(Baseline, UnmatchedLinesAreEachEntrysFirstInOrder) {
+  // (1, 2) of frame 5 twice (lines 2 and 4), frame 9's entry before frame 3's.
+  Baseline baseline =
+      Baseline::parse("frame,face_a,face_b\n5,1,2\n9,0,1\n5,2,1\n3,0,1\n", "b.csv", {});
+  for (const int64_t number : {3, 5, 9}) {
+    FrameRecord f = frame_with(number, {});
+    baseline.mark(f);
+  }
+  EXPECT_EQ(baseline.use(), expected_use(3, 3, {2, 3, 5}));
 }
 
 TEST(Baseline, FacesInEitherOrderAreOnePair) {
@@ -348,6 +391,20 @@ TEST(Baseline, ObjectColumnsMustFitTheRun) {
     const auto [line, message] = refusal("frame,face_a,face_b\n1,2,3\n", objects);
     EXPECT_EQ(line, 1);
     EXPECT_NE(message.find("no object_a and object_b columns"), std::string::npos) << message;
+  }
+  {
+    // A row short of its object columns.
+    const auto [line, message] =
+        refusal("frame,face_a,face_b,object_a,object_b\n1,0,1,dress\n", objects);
+    EXPECT_EQ(line, 2);
+    EXPECT_NE(message.find("only 4 fields"), std::string::npos) << message;
+  }
+  {
+    // Blanks around a quoted name are not part of it.
+    Baseline baseline = Baseline::parse(
+        "frame,face_a,face_b,object_a,object_b\n1, 0, 1, dress , \"body, \"\"v2\"\"\" \n", "b.csv",
+        objects);
+    EXPECT_EQ(baseline.entries(), 1);
   }
   {
     const auto [line, message] = refusal("frame,face_a,face_b,object_a\n", objects);

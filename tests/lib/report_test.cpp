@@ -179,6 +179,11 @@ TEST(ReportCsv, QuotesOnlyWhenNeeded) {
   EXPECT_EQ(csv_field("a,b"), "\"a,b\"");
   EXPECT_EQ(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
   EXPECT_EQ(csv_field("line\nbreak"), "\"line\nbreak\"");
+  // Blanks at either end are quoted, so that a reader dropping those around values (a
+  // --baseline) keeps them; inside a field they need nothing.
+  EXPECT_EQ(csv_field("cloth "), "\"cloth \"");
+  EXPECT_EQ(csv_field("\tbody"), "\"\tbody\"");
+  EXPECT_EQ(csv_field("left sleeve"), "left sleeve");
 }
 
 TEST(ReportJson, ParsesBackWithTheFields) {

@@ -48,7 +48,14 @@ class CsvRecords {
  private:
   /// Reads one field into `field`; true when it ended its record (a line end or the text's).
   bool read_field(std::string& field) {
+    // Spaces and tabs typed around a value ("frame, face_a", `1, "a, b" ,2`) are not part of it.
+    const auto skip_blanks = [&] {
+      while (at_ < text_.size() && (text_[at_] == ' ' || text_[at_] == '\t')) ++at_;
+    };
+    const size_t start = at_;
+    skip_blanks();
     last_field_quoted_ = at_ < text_.size() && text_[at_] == '"';
+    if (!last_field_quoted_) at_ = start;
     if (last_field_quoted_) {
       ++at_;
       for (;;) {
@@ -66,10 +73,10 @@ class CsvRecords {
         if (c == '\n') ++line_;
         field += c;
       }
+      skip_blanks();
     } else {
       const size_t end = text_.find_first_of(",\r\n\"", at_);
       const size_t stop = end == std::string_view::npos ? text_.size() : end;
-      // Spaces around a value typed by hand ("frame, face_a") are not part of it.
       std::string_view value = text_.substr(at_, stop - at_);
       while (!value.empty() && (value.front() == ' ' || value.front() == '\t'))
         value.remove_prefix(1);
@@ -199,7 +206,10 @@ Baseline Baseline::parse(std::string_view text, const std::string& name,
   Baseline baseline;
   baseline.name_ = name;
   baseline.whole_file_.assign(std::max<size_t>(objects.size(), 1), true);
-  for (size_t i = 0; i < objects.size(); ++i) baseline.whole_file_[i] = !objects[i].group;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    baseline.whole_file_[i] = !objects[i].group;
+    baseline.object_names_.push_back(objects[i].name);
+  }
   std::vector<Entry> every_frame;
   while (records.next(fields)) {
     const int64_t line = records.line();
@@ -301,26 +311,30 @@ void Baseline::mark(FrameRecord& frame) {
   const auto last =
       std::upper_bound(first, per_frame_end, frame.frame,
                        [](int64_t number, const Entry& e) { return number < e.frame; });
-  // An entry's faces must be faces of the frame it is for (where their count is known).
+  // An entry's faces must be faces of the frame it is for, where their count is known; an
+  // every-frame entry is held to the frames up to the first whose face list changed (its ids
+  // were found in one face list, and a later one may have fewer faces).
+  face_list_changed_ = face_list_changed_ || frame.topology_changed;
   const auto triangles_of = [&](int32_t object) -> int64_t {
     if (static_cast<size_t>(object) >= whole_file_.size() || !whole_file_[object]) return -1;
     if (frame.objects.empty()) return object == 0 ? frame.triangles : -1;
     return static_cast<size_t>(object) < frame.objects.size() ? frame.objects[object].triangles
                                                               : -1;
   };
-  const auto check = [&](Entry& e) {
+  const auto check = [&](Entry& e, bool bounded) {
     e.checked = true;
+    if (!bounded) return;
     for (const auto& [object, face] : {std::pair{e.object_a, e.a}, std::pair{e.object_b, e.b}})
       if (const int64_t count = triangles_of(object); count >= 0 && face >= count)
-        throw InputError(
-            name_, e.line,
-            "face " + std::to_string(face) + " is not a face of frame " +
-                std::to_string(frame.frame) + " (" + std::to_string(count) + " triangles" +
-                (frame.objects.empty() ? "" : " in its object " + std::to_string(object)) +
-                "): is the baseline for another mesh?");
+        throw InputError(name_, e.line,
+                         "face " + std::to_string(face) + " is not a face of frame " +
+                             std::to_string(frame.frame) + " (" +
+                             (frame.objects.empty() ? "" : object_names_[object] + ": ") +
+                             std::to_string(count) + (count == 1 ? " triangle" : " triangles") +
+                             "): is the baseline for another mesh?");
   };
-  for (auto e = first; e != last; ++e) check(*e);
-  for (auto e = per_frame_end; e != entries_.end(); ++e) check(*e);
+  for (auto e = first; e != last; ++e) check(*e, true);
+  for (auto e = per_frame_end; e != entries_.end(); ++e) check(*e, !face_list_changed_);
   // The entry of `pair` in [begin, end) (sorted by pair), if it accepts the pair as it is now.
   const auto accepts = [](auto begin, auto end, const Pair& p) {
     auto object_a = p.object_a, a = p.a, object_b = p.object_b, b = p.b;

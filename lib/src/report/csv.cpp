@@ -28,7 +28,12 @@ std::vector<size_t> frame_order(const Report& report) {
 }  // namespace
 
 std::string csv_field(std::string_view field) {
-  if (field.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(field);
+  // Spaces or tabs at either end are quoted too: a reader that drops those around a value (a
+  // --baseline typed by hand) must still get a name such as "cloth " back whole.
+  const auto blank = [](char c) { return c == ' ' || c == '\t'; };
+  const bool blank_end = !field.empty() && (blank(field.front()) || blank(field.back()));
+  if (!blank_end && field.find_first_of(",\"\r\n") == std::string_view::npos)
+    return std::string(field);
   std::string quoted = "\"";
   for (char c : field) {
     if (c == '"') quoted += '"';

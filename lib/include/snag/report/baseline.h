@@ -4,11 +4,11 @@
 //
 //   frame,face_a,face_b,kind,poly_a,poly_b[,object_a,object_b][,accepted]
 //
-// Columns are found by their header names, in any order (spaces around a name or an unquoted
-// value are dropped); frame, face_a and face_b are required, object_a and object_b exactly when
-// the run has objects (--obstacle, --scene, --split-groups), kind and accepted are optional,
-// every other column (poly_a, poly_b) is ignored, and a row may stop before optional columns.
-// Each row is an accepted pair:
+// Columns are found by their header names, in any order (spaces and tabs around a name or a
+// value, quoted or not, are dropped); frame, face_a and face_b are required, object_a and object_b
+// exactly when the run has objects (--obstacle, --scene, --split-groups), kind and accepted are
+// optional, every other column (poly_a, poly_b) is ignored, and a row may stop before optional
+// columns. Each row is an accepted pair:
 // - frame: the frame number, or `*` for every frame;
 // - face_a, face_b: triangle ids as pairs.csv gives them (not polygon ids), in either order;
 // - kind: `crossing` accepts the pair whatever its kind, `touching` only while it touches (a
@@ -44,10 +44,11 @@ class Baseline {
 
   /// Sets Pair::accepted on each of `frame`'s pairs that the baseline accepts (and clears it
   /// on the others), and notes which entries accepted a pair and which frames were checked.
-  /// Frames may come in any order. Throws InputError (the file and the entry's line) when an
-  /// entry for this frame names a face past the frame's triangles: single-mesh runs, and the
-  /// objects of a scene that are whole files (an OBJ group's ids are its file's, not counted
-  /// here). frame.triangles (single mesh) or frame.objects[i].triangles must be the frame's.
+  /// Frames come in the order they were checked. Throws InputError (the file and the entry's
+  /// line) when an entry for this frame names a face past the frame's triangles: single-mesh
+  /// runs, and the objects of a scene that are whole files (an OBJ group's ids are its file's,
+  /// not counted here); every-frame entries only up to the first frame whose face list changed.
+  /// frame.triangles (single mesh) or frame.objects[i].triangles must be the frame's.
   void mark(FrameRecord& frame);
 
   /// Distinct pairs listed (a pair listed twice for one frame, or for every frame, is one
@@ -73,6 +74,8 @@ class Baseline {
   /// Per object: whether its ids are those of a whole file counted by its triangles (a single
   /// mesh, or a scene object that is not an OBJ group), so that mark() can bound them.
   std::vector<bool> whole_file_;
+  std::vector<std::string> object_names_;  ///< a scene's, for messages
+  bool face_list_changed_ = false;         ///< a frame marked so far had a topology change
   /// The entries of numbered frames, sorted by (frame, object_a, a, object_b, b), then from
   /// every_frame_begin_ on those of every frame, sorted by (object_a, a, object_b, b).
   std::vector<Entry> entries_;

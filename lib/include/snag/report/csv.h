@@ -1,5 +1,5 @@
 // The CSV reports, byte for byte (RFC 4180: comma separated, "\n" line ends, a field with a
-// comma, quote or line break quoted with its quotes doubled).
+// comma, quote or line break, or a space or tab at either end, quoted with its quotes doubled).
 //
 // pairs.csv:  frame,face_a,face_b,kind,poly_a,poly_b
 //   one row per intersecting pair, face_a < face_b, rows sorted by (frame, face_a, face_b).
@@ -73,7 +73,8 @@ void append_pairs_rows(std::string& out, const FrameRecord& frame,
 void write_frames_row(std::ostream& out, const FrameRecord& frame,
                       std::span<const ObjectInput> objects = {}, bool baseline = false);
 
-/// `field` as one CSV field: unchanged unless it holds a comma, quote, CR or LF.
+/// `field` as one CSV field: unchanged unless it holds a comma, quote, CR or LF, or begins or
+/// ends with a space or tab.
 std::string csv_field(std::string_view field);
 
 }  // namespace snag::report
