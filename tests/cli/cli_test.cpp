@@ -155,6 +155,40 @@ TEST(CliCheck, ProgressIsOneLinePerFrameWhenNotATerminal) {
   EXPECT_NE(r.err.find("[3/3] frame 3: clean"), std::string::npos) << r.err;
 }
 
+// On a terminal the progress is one bar redrawn in place ("\r" and erase to the line's end); a
+// line longer than the terminal would wrap and leave its first rows behind at each redraw, so
+// each drawing is cut a column short of the width. The bar is erased before the summary.
+TEST(CliCheck, ProgressOnATerminalIsABarCutToItsWidth) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const std::string redraw = "\r\033[K";
+  for (const int columns : {40, 200}) {
+    SCOPED_TRACE(std::to_string(columns) + " columns");
+    const std::optional<RunResult> run =
+        run_snag_in_terminal({"check", "seq"}, tmp.path(), columns);
+    if (!run) GTEST_SKIP() << "no pseudo-terminal can be opened here: the bar is not tested";
+    const RunResult& r = *run;
+    EXPECT_EQ(r.status, 1) << r.out;
+    // The drawings: what follows each redraw up to the next control character.
+    std::vector<std::string> drawn;
+    for (size_t at = r.out.find(redraw); at != std::string::npos; at = r.out.find(redraw, at)) {
+      at += redraw.size();
+      const size_t end = r.out.find_first_of("\r\n\033", at);
+      drawn.push_back(r.out.substr(at, end - at));
+    }
+    // One per frame, then the erase, right before the summary (on standard output, the same
+    // terminal).
+    ASSERT_EQ(drawn.size(), 4u) << r.out;
+    const std::vector<std::string> full = {
+        "[##########....................] 1/3  frame 1: 1 crossing, 0 touching",
+        "[####################..........] 2/3  frame 2: 1 crossing, 0 touching (topology changed)",
+        "[##############################] 3/3  frame 3: clean"};
+    for (size_t i = 0; i < full.size(); ++i)
+      EXPECT_EQ(drawn[i], full[i].substr(0, std::min<size_t>(full[i].size(), columns - 1)));
+    EXPECT_EQ(drawn[3], "frames checked       3");
+  }
+}
+
 // --frames naming frames the sequence lacks (a cache with a frame missing, or cut short), or a
 // sequence that skips a number: the frames there are checked, and a warning names the ones
 // that are not; a broken link among the frames is an input error naming it.

@@ -20,6 +20,12 @@ struct RunResult {
 /// Runs snag with `args` in working directory `cwd`, standard input closed, and waits for it.
 RunResult run_snag(const std::vector<std::string>& args, const std::filesystem::path& cwd);
 
+/// Runs snag with `args` in `cwd` on a pseudo-terminal `columns` wide (standard input, output and
+/// error all on it, as in an interactive shell); `out` holds everything it wrote there, `err`
+/// nothing. nullopt when no pseudo-terminal can be opened here (a container without /dev/pts).
+std::optional<RunResult> run_snag_in_terminal(const std::vector<std::string>& args,
+                                              const std::filesystem::path& cwd, int columns);
+
 /// run_snag with $SNAG_DATA_DIR an empty folder (cwd/no-data), so that a bench leaves out its
 /// shared-data cases; $SNAG_DATA_DIR is as it was afterwards.
 RunResult run_snag_without_data(const std::vector<std::string>& args,
