@@ -21,6 +21,7 @@
 #include "snag/error.h"
 #include "snag/io/read_mesh.h"
 #include "snag/report/baseline.h"
+#include "snag/report/junit.h"
 #include "snag/report/report.h"
 #include "snag/report/stream.h"
 #include "snag/report/write.h"
@@ -372,6 +373,12 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
       ->type_name("FILE")
       ->check(non_empty("a baseline file"))
       ->check(not_an_option("a baseline file"));
+  cmd->add_option("--junit", o.junit,
+                  "Also write a JUnit XML report to FILE for a CI server to show: a test case "
+                  "per frame, failing as --fail-on says")
+      ->type_name("FILE")
+      ->check(non_empty("a file"))
+      ->check(not_an_option("a file"));
   cmd->add_option("--exact", o.exact,
                   "How signs are decided: off (the double filter decides all, even where its "
                   "error bound cannot; fast, may be wrong on degenerate input), uncertain (what "
@@ -424,6 +431,14 @@ int run_check(const CheckOptions& o) {
   // once rather than after an hour of checking.
   std::optional<report::OutputDirectory> output_directory;
   if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
+  // So is a --junit that names a directory, or one whose directory cannot be made.
+  std::optional<report::OutputDirectory> junit_directory;
+  if (!o.junit.empty()) {
+    const std::filesystem::path junit_path(o.junit);
+    if (std::filesystem::is_directory(junit_path))
+      throw report::WriteError(junit_path, "is a directory; --junit names the file to write");
+    junit_directory.emplace(junit_path.parent_path().empty() ? "." : junit_path.parent_path());
+  }
   // So is a baseline that cannot be read, or that names objects this run does not have.
   std::optional<report::Baseline> baseline;
   if (!o.baseline.empty())
@@ -473,6 +488,8 @@ int run_check(const CheckOptions& o) {
   // GPU's checks of many pairs); the formatters idle otherwise.
   report::ReportStream reports(report_dir, SNAG_VERSION, std::move(report_settings), inputs.objects,
                                threads);
+  std::optional<report::JunitReport> junit;
+  if (!o.junit.empty()) junit.emplace(inputs.sequence, *fail_on, inputs.objects);
 
   SequenceSettings sequence;
   sequence.weld = o.weld;
@@ -497,6 +514,7 @@ int run_check(const CheckOptions& o) {
         collapsed.note(record, warn);
         progress.update(reports.summary().frames_checked + 1,
                         frame_note(record, baseline.has_value()));
+        if (junit) junit->add(record);
         reports.add(std::move(record));
       },
       warn);
@@ -512,6 +530,14 @@ int run_check(const CheckOptions& o) {
   const report::Summary summary =
       reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
   if (output_directory) output_directory->keep();
+  if (junit) {
+    // Written whole under a temporary name beside it and renamed into place, as the reports.
+    const std::filesystem::path junit_path(o.junit);
+    report::write_files_atomically(
+        junit_path.parent_path().empty() ? "." : junit_path.parent_path(),
+        {{junit_path.filename().string(), [&](std::ostream& out) { junit->write(out); }}});
+    junit_directory->keep();
+  }
 
   print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs, o.baseline);
   std::cout.flush();

@@ -87,6 +87,7 @@ struct CheckOptions {
   int threads = 0;
   std::string fail_on = "crossing";
   std::string baseline;  ///< --baseline FILE, empty when not given
+  std::string junit;     ///< --junit FILE, empty when not given
   std::string exact = "uncertain";
   bool quiet = false;
 };

@@ -739,6 +739,54 @@ TEST(CliBaseline, ABadBaselineExitsThreeBeforeAnyFrameAndWritesNoReport) {
   EXPECT_EQ(run_snag({"check", "seq", "--baseline", ""}, tmp.path()).status, 2);
 }
 
+// --junit: a JUnit XML report beside the others, for a CI server's test view.
+TEST(CliCheck, AJunitReportHasAFailingCasePerFailingFrame) {
+  TempDir tmp;
+  write_hand_built_sequence(tmp.path() / "seq");
+  const RunResult r = run_snag({"check", "seq", "--junit", "ci/snag.xml", "-q"}, tmp.path());
+  EXPECT_EQ(r.status, 1) << context(r);
+  const std::string xml = read_text(tmp.path() / "ci" / "snag.xml");
+  EXPECT_EQ(xml.rfind("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"snag check\" "
+                      "tests=\"3\" failures=\"2\"",
+                      0),
+            0u)
+      << xml;
+  EXPECT_NE(xml.find("<testsuite name=\"seq\" tests=\"3\" failures=\"2\""), std::string::npos)
+      << xml;
+  // Frames 1 and 2 cross (the pair as pairs.csv gives it), frame 3 is clean.
+  EXPECT_NE(xml.find("name=\"frame 1: seq/f.0001.obj\" time=\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<failure type=\"crossing\" message=\"1 crossing pair (--fail-on "
+                     "crossing)\">frame,face_a,face_b,kind,poly_a,poly_b\n1,1,2,crossing,0,1\n"
+                     "</failure>"),
+            std::string::npos)
+      << xml;
+  EXPECT_NE(xml.find("\n2,0,2,crossing,0,1\n</failure>"), std::string::npos) << xml;
+  const size_t third = xml.find("name=\"frame 3: seq/f.0003.obj\"");
+  ASSERT_NE(third, std::string::npos) << xml;
+  EXPECT_EQ(xml.find("<failure", third), std::string::npos) << xml;
+  EXPECT_EQ(directory_entries(tmp.path() / "ci"), std::vector<std::string>{"snag.xml"});
+
+  // With frame 1's pair accepted, only frame 2 fails.
+  write_text(tmp.path() / "accepted.csv", "frame,face_a,face_b\n1,1,2\n");
+  EXPECT_EQ(run_snag({"check", "seq", "--junit", "ci/snag.xml", "--baseline", "accepted.csv", "-q"},
+                     tmp.path())
+                .status,
+            1);
+  EXPECT_NE(read_text(tmp.path() / "ci" / "snag.xml").find("failures=\"1\""), std::string::npos);
+
+  // A run that fails on a bad frame writes none, and removes the directory it made for it.
+  write_text(tmp.path() / "seq" / "f.0004.obj", "v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n");
+  const RunResult bad = run_snag({"check", "seq", "--junit", "new/snag.xml"}, tmp.path());
+  EXPECT_EQ(bad.status, 3) << context(bad);
+  EXPECT_FALSE(fs::exists(tmp.path() / "new"));
+  // A directory in the file's place is refused before any frame.
+  const RunResult directory = run_snag({"check", "seq", "--junit", "ci"}, tmp.path());
+  EXPECT_EQ(directory.status, 3) << context(directory);
+  EXPECT_NE(directory.err.find("ci: is a directory; --junit names the file to write"),
+            std::string::npos)
+      << directory.err;
+}
+
 TEST(CliStatus, UsageErrorsExitTwo) {
   TempDir tmp;
   write_hand_built_sequence(tmp.path() / "seq");

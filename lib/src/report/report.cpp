@@ -149,10 +149,8 @@ void SummaryAccumulator::add(const FrameRecord& frame) {
     s.worst_frame = position;
     s.worst = WorstFrame{frame.frame, frame.file, crossing, pairs};
   }
-  const int64_t new_crossing = crossing - frame.accepted_crossing_count();
-  const bool frame_fails = fail_on_ == FailOn::crossing ? new_crossing > 0
-                           : fail_on_ == FailOn::any    ? accepted < pairs
-                                                        : false;
+  const bool frame_fails = std::any_of(frame.pairs.begin(), frame.pairs.end(),
+                                       [&](const Pair& p) { return pair_fails(p, fail_on_); });
   if (frame_fails && !s.first_failing_frame) s.first_failing_frame = frame.frame;
   s.failed = s.first_failing_frame.has_value();
 }

@@ -40,6 +40,13 @@ struct Pair {
   friend bool operator==(const Pair&, const Pair&) = default;
 };
 
+/// Whether `pair` fails a run under `fail_on` on its own: a crossing pair (with `any`, any
+/// pair) that the baseline does not accept.
+inline bool pair_fails(const Pair& pair, FailOn fail_on) {
+  if (pair.accepted || fail_on == FailOn::none) return false;
+  return fail_on == FailOn::any || pair.kind == detect::PairKind::crossing;
+}
+
 /// Pair order in every report: by (object_a, a, object_b, b).
 inline bool pair_order(const Pair& x, const Pair& y) {
   if (x.object_a != y.object_a) return x.object_a < y.object_a;
