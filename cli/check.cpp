@@ -266,6 +266,41 @@ void print_summary(std::ostream& out, const report::Summary& s, const RunTotals&
         << "{pairs.csv,frames.csv,report.json}\n";
 }
 
+/// The --junit file, refused before any frame (WriteError) where it could not be the run's new
+/// file, or would replace something that is not a report of snag's: no file name ("dir/",
+/// "x/.."), "-", something other than a regular file in its place (a directory, a device, a
+/// link, which the rename would replace rather than write through), or a file the run reads or
+/// writes (the baseline, the scene file, a frame, a report of --out).
+std::filesystem::path junit_path_of(const CheckOptions& o, const scene::ResolvedScene& resolved) {
+  namespace fs = std::filesystem;
+  const fs::path path(o.junit);
+  const fs::path name = path.filename();
+  if (o.junit == "-" || name.empty() || name == "." || name == "..")
+    throw report::WriteError(path, "not a file name; --junit names the file to write");
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(path, error);
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw report::WriteError(path, std::string(fs::is_directory(status) ? "a directory"
+                                               : fs::is_symlink(status) ? "a symbolic link"
+                                                                        : "not a regular file") +
+                                       "; --junit writes a new file in its place");
+  const auto same = [&](const fs::path& other) {
+    return fs::weakly_canonical(other, error) == fs::weakly_canonical(path, error);
+  };
+  const auto refuse = [&](const std::string& what) {
+    throw report::WriteError(path, "is " + what + "; --junit would replace it");
+  };
+  if (!o.baseline.empty() && same(o.baseline)) refuse("the --baseline");
+  if (!o.scene.empty() && same(o.scene)) refuse("the scene file");
+  if (!o.out_dir.empty())
+    for (const char* report : {"pairs.csv", "frames.csv", "report.json"})
+      if (same(fs::path(o.out_dir) / report)) refuse("a report of --out");
+  for (const scene::ResolvedObject& object : resolved.objects)
+    for (const seq::Frame& frame : object.frames)
+      if (same(frame.path)) refuse("a frame of " + object.spec.sequence);
+  return path;
+}
+
 /// A sequence whose frames are files of several kinds ('dress.*' matching dress.0003.obj.bak
 /// beside the .obj frames, read through assimp): each is a frame, which is rarely what was
 /// meant; said once, with the count of each kind.
@@ -431,12 +466,11 @@ int run_check(const CheckOptions& o) {
   // once rather than after an hour of checking.
   std::optional<report::OutputDirectory> output_directory;
   if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
-  // So is a --junit that names a directory, or one whose directory cannot be made.
+  // So is a --junit that cannot be written, or would replace what is not a report.
   std::optional<report::OutputDirectory> junit_directory;
+  std::filesystem::path junit_path;
   if (!o.junit.empty()) {
-    const std::filesystem::path junit_path(o.junit);
-    if (std::filesystem::is_directory(junit_path))
-      throw report::WriteError(junit_path, "is a directory; --junit names the file to write");
+    junit_path = junit_path_of(o, resolved);
     junit_directory.emplace(junit_path.parent_path().empty() ? "." : junit_path.parent_path());
   }
   // So is a baseline that cannot be read, or that names objects this run does not have.
@@ -526,18 +560,18 @@ int run_check(const CheckOptions& o) {
   totals.rebuilds = checker->rebuild_count();
   totals.wall_seconds = seconds_since(started);
   if (baseline) inputs.baseline = baseline->use();
-  // Only now, with every frame read, checked and written, do the report files appear.
-  const report::Summary summary =
-      reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
-  if (output_directory) output_directory->keep();
+  // Only now, with every frame read, checked and written, do the report files appear: the
+  // JUnit file first (written whole under a temporary name beside it and renamed into place),
+  // so that a run that cannot write it leaves no new report at all; then --out's.
   if (junit) {
-    // Written whole under a temporary name beside it and renamed into place, as the reports.
-    const std::filesystem::path junit_path(o.junit);
     report::write_files_atomically(
         junit_path.parent_path().empty() ? "." : junit_path.parent_path(),
         {{junit_path.filename().string(), [&](std::ostream& out) { junit->write(out); }}});
     junit_directory->keep();
   }
+  const report::Summary summary =
+      reports.finish(inputs, totals.builds, totals.rebuilds, totals.wall_seconds);
+  if (output_directory) output_directory->keep();
 
   print_summary(std::cout, summary, totals, o.rebuild, o.out_dir, inputs, o.baseline);
   std::cout.flush();

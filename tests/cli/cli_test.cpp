@@ -779,12 +779,50 @@ TEST(CliCheck, AJunitReportHasAFailingCasePerFailingFrame) {
   const RunResult bad = run_snag({"check", "seq", "--junit", "new/snag.xml"}, tmp.path());
   EXPECT_EQ(bad.status, 3) << context(bad);
   EXPECT_FALSE(fs::exists(tmp.path() / "new"));
-  // A directory in the file's place is refused before any frame.
-  const RunResult directory = run_snag({"check", "seq", "--junit", "ci"}, tmp.path());
-  EXPECT_EQ(directory.status, 3) << context(directory);
-  EXPECT_NE(directory.err.find("ci: is a directory; --junit names the file to write"),
-            std::string::npos)
-      << directory.err;
+  fs::remove(tmp.path() / "seq" / "f.0004.obj");
+
+  // Under --fail-on any the failures say so.
+  EXPECT_EQ(
+      run_snag({"check", "seq", "--junit", "ci/any.xml", "--fail-on", "any", "-q"}, tmp.path())
+          .status,
+      1);
+  EXPECT_NE(read_text(tmp.path() / "ci" / "any.xml")
+                .find("<failure type=\"any\" message=\"1 intersecting pair (--fail-on any)\">"),
+            std::string::npos);
+
+  // Refused before any frame, nothing replaced: no file name, standard output's "-", a
+  // directory or a link in its place, a file the run reads or writes, a directory that
+  // cannot be made.
+  write_text(tmp.path() / "accepted.csv", "frame,face_a,face_b\n1,1,2\n");
+  fs::create_directory(tmp.path() / "out");
+  write_text(tmp.path() / "out" / "pairs.csv", "earlier\n");
+  fs::create_symlink("elsewhere.xml", tmp.path() / "link.xml");
+  write_text(tmp.path() / "a-file", "x");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+      {{"--junit", "ci"}, "ci: a directory; --junit writes a new file in its place"},
+      {{"--junit", "new/"}, "new/: not a file name"},
+      {{"--junit", "ci/.."}, "ci/..: not a file name"},
+      {{"--junit", "-"}, "-: not a file name"},
+      {{"--junit", "link.xml"}, "link.xml: a symbolic link"},
+      {{"--junit", "accepted.csv", "--baseline", "accepted.csv"},
+       "accepted.csv: is the --baseline; --junit would replace it"},
+      {{"--junit", "out/pairs.csv", "--out", "out"},
+       "out/pairs.csv: is a report of --out; --junit would replace it"},
+      {{"--junit", "seq/../seq/f.0002.obj"}, "is a frame of seq; --junit would replace it"},
+      {{"--junit", "a-file/snag.xml"}, "a-file"},
+  };
+  for (const auto& [args, says] : refused) {
+    std::vector<std::string> all = {"check", "seq"};
+    all.insert(all.end(), args.begin(), args.end());
+    const RunResult r = run_snag(all, tmp.path());
+    EXPECT_EQ(r.status, 3) << context(r);
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("frame 1"), std::string::npos) << "a frame was checked: " << r.err;
+  }
+  EXPECT_EQ(read_text(tmp.path() / "out" / "pairs.csv"), "earlier\n");
+  EXPECT_EQ(read_text(tmp.path() / "accepted.csv"), "frame,face_a,face_b\n1,1,2\n");
+  EXPECT_TRUE(fs::is_symlink(tmp.path() / "link.xml"));
+  EXPECT_FALSE(fs::exists(tmp.path() / "new"));
 }
 
 TEST(CliStatus, UsageErrorsExitTwo) {

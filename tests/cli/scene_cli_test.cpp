@@ -270,8 +270,8 @@ TEST(SceneObstacle, ABaselineNamesEachFacesObject) {
              "object_b,object_a,frame,face_a,face_b\n"
              "cloth,body,*,0,1\n"
              "cloth,cloth,3,0,1\n");
-  const SceneRun run = run_in(
-      tmp.path(), {"sheet.%04d.obj", "--obstacle", "body.%04d.obj", "--baseline", "accepted.csv"});
+  const SceneRun run = run_in(tmp.path(), {"sheet.%04d.obj", "--obstacle", "body.%04d.obj",
+                                           "--baseline", "accepted.csv", "--junit", "out/s.xml"});
   ASSERT_EQ(run.result.status, 1) << context(run.result);
   EXPECT_EQ(run.pairs_csv,
             "frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b,accepted\n"
@@ -286,6 +286,13 @@ TEST(SceneObstacle, ABaselineNamesEachFacesObject) {
                                                           {"unmatched", 1},
                                                           {"unmatched_lines", {3}}}));
   EXPECT_EQ(run.report.at("summary").at("first_new_frame"), 2);
+  // The JUnit report's failures name each face's object, as pairs.csv does.
+  const std::string xml = read_text(tmp.path() / "out" / "s.xml");
+  EXPECT_NE(xml.find("failures=\"2\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find(">frame,face_a,face_b,kind,poly_a,poly_b,object_a,object_b\n"
+                     "3,0,0,crossing,0,0,cloth,body\n</failure>"),
+            std::string::npos)
+      << xml;
 
   // An object the run does not have is named, with the run's objects.
   write_text(tmp.path() / "other.csv",

@@ -37,7 +37,7 @@ std::string seconds_text(double seconds) {
 
 }  // namespace
 
-std::string xml_escaped(std::string_view text) {
+std::string xml_escaped(std::string_view text, bool attribute) {
   std::string out;
   out.reserve(text.size());
   for (size_t at = 0; at < text.size();) {
@@ -59,6 +59,17 @@ std::string xml_escaped(std::string_view text) {
         break;
       case '"':
         out += "&quot;";
+        break;
+      // A parser normalizes a line end to "\n" in text and every blank to a space in an
+      // attribute: as references they come back as written.
+      case '\r':
+        out += "&#13;";
+        break;
+      case '\n':
+        out += attribute ? "&#10;" : "\n";
+        break;
+      case '\t':
+        out += attribute ? "&#9;" : "\t";
         break;
       case '\'':
         out += "&apos;";
@@ -98,8 +109,7 @@ void JunitReport::add(const FrameRecord& frame) {
     c.text = pairs_csv_header_for(objects_) + "\n";
     append_pairs_rows(c.text, failing, objects_);
     if (count > static_cast<int64_t>(kListedPairs))
-      c.text += "... and " + std::to_string(count - static_cast<int64_t>(kListedPairs)) +
-                " more (pairs.csv lists them all)\n";
+      c.text += "... and " + std::to_string(count - static_cast<int64_t>(kListedPairs)) + " more\n";
   }
   cases_.push_back(std::move(c));
 }
@@ -117,17 +127,17 @@ void JunitReport::write(std::ostream& out) const {
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   out << "<testsuites name=\"snag check\"" << counts << " time=\"" << seconds_text(seconds)
       << "\">\n";
-  out << "  <testsuite name=\"" << xml_escaped(suite_) << "\"" << counts
+  out << "  <testsuite name=\"" << xml_escaped(suite_, true) << "\"" << counts
       << " skipped=\"0\" errors=\"0\" time=\"" << seconds_text(seconds) << "\">\n";
   for (const Case& c : cases_) {
     out << "    <testcase classname=\"snag.check\" name=\"frame " << c.frame << ": "
-        << xml_escaped(c.file) << "\" time=\"" << seconds_text(c.seconds) << "\"";
+        << xml_escaped(c.file, true) << "\" time=\"" << seconds_text(c.seconds) << "\"";
     if (!c.failed) {
       out << "/>\n";
       continue;
     }
     out << ">\n      <failure type=\"" << (fail_on_ == FailOn::crossing ? "crossing" : "any")
-        << "\" message=\"" << xml_escaped(c.message) << "\">" << xml_escaped(c.text)
+        << "\" message=\"" << xml_escaped(c.message, true) << "\">" << xml_escaped(c.text, false)
         << "</failure>\n    </testcase>\n";
   }
   out << "  </testsuite>\n</testsuites>\n";

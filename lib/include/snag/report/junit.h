@@ -6,8 +6,9 @@
 // failure whose text lists those pairs as pairs.csv rows (the first kListedPairs of them).
 //
 //   <?xml version="1.0" encoding="UTF-8"?>
-//   <testsuites name="snag check" tests="12" failures="3" time="0.013">
-//     <testsuite name="SEQUENCE" tests="12" failures="3" skipped="0" errors="0" time="0.013">
+//   <testsuites name="snag check" tests="12" failures="3" time="0.013204">
+//     <testsuite name="SEQUENCE" tests="12" failures="3" skipped="0" errors="0"
+//                time="0.013204">
 //       <testcase classname="snag.check" name="frame 5: samples/drape/drape.0005.obj"
 //                 time="0.000796">
 //         <failure type="crossing" message="81 crossing pairs (--fail-on crossing)">
@@ -17,7 +18,8 @@
 //       </testcase>
 //       ...
 //
-// Times are the frames' checking seconds (frames.csv's `seconds`). Text is escaped for XML;
+// Times are the frames' checking seconds (frames.csv's `seconds`), 6 decimals; a scene run's
+// frames are named by their first object's file. Text is escaped for XML;
 // bytes that XML 1.0 cannot hold (control characters, invalid UTF-8 in a file name) become
 // U+FFFD.
 #pragma once
@@ -64,9 +66,10 @@ class JunitReport {
   std::vector<Case> cases_;
 };
 
-/// `text` escaped for XML character data and attribute values (&, <, >, " and '), with every
-/// byte or sequence XML 1.0 cannot hold (control characters but tab, line feed and carriage
-/// return; invalid UTF-8) replaced by U+FFFD.
-std::string xml_escaped(std::string_view text);
+/// `text` escaped for XML (&, <, >, " and '; a carriage return as a reference, and in an
+/// `attribute` value a tab and a line feed too, which a parser would turn into spaces), with
+/// every byte or sequence XML 1.0 cannot hold (control characters but tab, line feed and
+/// carriage return; invalid UTF-8) replaced by U+FFFD.
+std::string xml_escaped(std::string_view text, bool attribute);
 
 }  // namespace snag::report
