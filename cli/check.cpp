@@ -284,8 +284,15 @@ std::filesystem::path junit_path_of(const CheckOptions& o, const scene::Resolved
                                                : fs::is_symlink(status) ? "a symbolic link"
                                                                         : "not a regular file") +
                                        "; --junit writes a new file in its place");
+  // Compared as the filesystem resolves them ("seq/../seq/f.0002.obj" is a frame), or by their
+  // spelling where a path cannot be resolved (a directory that cannot be read).
+  const fs::path target = fs::weakly_canonical(path, error);
+  const bool resolved_target = !error;
   const auto same = [&](const fs::path& other) {
-    return fs::weakly_canonical(other, error) == fs::weakly_canonical(path, error);
+    std::error_code other_error;
+    const fs::path resolved_other = fs::weakly_canonical(other, other_error);
+    if (resolved_target && !other_error) return resolved_other == target;
+    return other.lexically_normal() == path.lexically_normal();
   };
   const auto refuse = [&](const std::string& what) {
     throw report::WriteError(path, "is " + what + "; --junit would replace it");
