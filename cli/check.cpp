@@ -475,10 +475,11 @@ int run_check(const CheckOptions& o) {
   if (!o.out_dir.empty()) output_directory.emplace(o.out_dir);
   // So is a --junit that cannot be written, or would replace what is not a report.
   std::optional<report::OutputDirectory> junit_directory;
-  std::filesystem::path junit_path;
+  std::filesystem::path junit_path, junit_dir;
   if (!o.junit.empty()) {
     junit_path = junit_path_of(o, resolved);
-    junit_directory.emplace(junit_path.parent_path().empty() ? "." : junit_path.parent_path());
+    junit_dir = junit_path.parent_path().empty() ? "." : junit_path.parent_path();
+    junit_directory.emplace(junit_dir);
   }
   // So is a baseline that cannot be read, or that names objects this run does not have.
   std::optional<report::Baseline> baseline;
@@ -571,9 +572,8 @@ int run_check(const CheckOptions& o) {
   // JUnit file first (written whole under a temporary name beside it and renamed into place),
   // so that a run that cannot write it leaves no new report at all; then --out's.
   if (junit) {
-    report::write_files_atomically(
-        junit_path.parent_path().empty() ? "." : junit_path.parent_path(),
-        {{junit_path.filename().string(), [&](std::ostream& out) { junit->write(out); }}});
+    report::write_files_atomically(junit_dir, {{junit_path.filename().string(),
+                                                [&](std::ostream& out) { junit->write(out); }}});
     junit_directory->keep();
   }
   const report::Summary summary =

@@ -26,16 +26,32 @@ fs::path snag_executable() {
   return SNAG_EXECUTABLE_DEFAULT;
 }
 
+namespace {
+
+/// snag's path and `args` as execv takes them: `argv` points into `words`, so a command is
+/// built where it is used and never copied or moved.
+struct SnagCommand {
+  explicit SnagCommand(const std::vector<std::string>& args)
+      : exe(snag_executable().string()), words{exe} {
+    words.insert(words.end(), args.begin(), args.end());
+    for (std::string& word : words) argv.push_back(word.data());
+    argv.push_back(nullptr);
+  }
+  SnagCommand(const SnagCommand&) = delete;
+  SnagCommand& operator=(const SnagCommand&) = delete;
+  std::string exe;
+  std::vector<std::string> words;
+  std::vector<char*> argv;
+};
+
+}  // namespace
+
 RunResult run_snag(const std::vector<std::string>& args, const fs::path& cwd) {
   TempDir capture;
   const fs::path out_path = capture.path() / "stdout";
   const fs::path err_path = capture.path() / "stderr";
-  const std::string exe = snag_executable().string();
-  std::vector<std::string> all = {exe};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
+  const SnagCommand command(args);
+  const std::string& exe = command.exe;
 
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed");
@@ -48,7 +64,7 @@ RunResult run_snag(const std::vector<std::string>& args, const fs::path& cwd) {
     ::dup2(in, 0);
     ::dup2(out, 1);
     ::dup2(err, 2);
-    ::execv(exe.c_str(), argv.data());
+    ::execv(exe.c_str(), command.argv.data());
     ::_exit(127);
   }
   int status = 0;
@@ -62,12 +78,8 @@ RunResult run_snag(const std::vector<std::string>& args, const fs::path& cwd) {
 
 std::optional<RunResult> run_snag_in_terminal(const std::vector<std::string>& args,
                                               const fs::path& cwd, int columns) {
-  const std::string exe = snag_executable().string();
-  std::vector<std::string> all = {exe};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
+  const SnagCommand command(args);
+  const std::string& exe = command.exe;
   winsize size{};
   size.ws_row = 24;
   size.ws_col = static_cast<unsigned short>(columns);
@@ -76,7 +88,7 @@ std::optional<RunResult> run_snag_in_terminal(const std::vector<std::string>& ar
   if (pid < 0) return std::nullopt;  // no pseudo-terminal to be had
   if (pid == 0) {
     if (::chdir(cwd.c_str()) != 0) ::_exit(126);
-    ::execv(exe.c_str(), argv.data());
+    ::execv(exe.c_str(), command.argv.data());
     ::_exit(127);
   }
   // Read until the child's side closes (EIO on Linux once it has exited), then reap it.

@@ -217,17 +217,20 @@ TEST(SceneObstacle, StillObstacleIsBuiltOnce) {
   EXPECT_EQ(column(run, "rebuilt"), (std::vector<std::string>{"1", "0", "0"}));
 }
 
-TEST(SceneObstacle, MovingObstacleSequence) {
-  TempDir tmp;
-  // The sheet stays; the post is far away (frame 1), crosses face 0 (frame 2), then stands
-  // across the diagonal and crosses both faces (frame 3).
+/// The sheet in every frame with a post that moves (body.%04d.obj): far away in frame 1, across
+/// face 0 in frame 2, across the diagonal and both faces in frame 3.
+void write_sheet_and_moving_post(const fs::path& dir) {
   const std::vector<std::vector<P>> posts = {moved(post(0.5), {5, 0, 0}), post(0.5), post(1.5)};
   for (int f = 1; f <= 3; ++f) {
-    write_text(tmp.path() / ("sheet.000" + std::to_string(f) + ".obj"),
-               obj_text(sheet, sheet_faces));
-    write_text(tmp.path() / ("body.000" + std::to_string(f) + ".obj"),
-               obj_text(posts[f - 1], one_face));
+    write_text(dir / ("sheet.000" + std::to_string(f) + ".obj"), obj_text(sheet, sheet_faces));
+    write_text(dir / ("body.000" + std::to_string(f) + ".obj"), obj_text(posts[f - 1], one_face));
   }
+}
+
+TEST(SceneObstacle, MovingObstacleSequence) {
+  TempDir tmp;
+  // The sheet stays; the post crosses face 0 in frame 2 and both faces in frame 3.
+  write_sheet_and_moving_post(tmp.path());
   const SceneRun run = run_in(tmp.path(), {"sheet.%04d.obj", "--obstacle", "body.%04d.obj"});
   ASSERT_EQ(run.result.status, 1) << context(run.result);
   EXPECT_EQ(run.pairs_csv,
@@ -259,13 +262,7 @@ TEST(SceneObstacle, ABaselineNamesEachFacesObject) {
   // As in MovingObstacleSequence: frame 2 has (cloth 0, body 0), frame 3 (cloth 0, body 0) and
   // (cloth 1, body 0). The baseline accepts the body's face 0 with the cloth's face 1, the
   // pair written body first; and the cloth's faces 0 and 1 with each other, which never meet.
-  const std::vector<std::vector<P>> posts = {moved(post(0.5), {5, 0, 0}), post(0.5), post(1.5)};
-  for (int f = 1; f <= 3; ++f) {
-    write_text(tmp.path() / ("sheet.000" + std::to_string(f) + ".obj"),
-               obj_text(sheet, sheet_faces));
-    write_text(tmp.path() / ("body.000" + std::to_string(f) + ".obj"),
-               obj_text(posts[f - 1], one_face));
-  }
+  write_sheet_and_moving_post(tmp.path());
   write_text(tmp.path() / "accepted.csv",
              "object_b,object_a,frame,face_a,face_b\n"
              "cloth,body,*,0,1\n"

@@ -34,6 +34,15 @@ class SequenceDir : public ::testing::Test {
     for (const std::string& n : names) std::ofstream(dir_ / n) << "v 0 0 0\n";
   }
   std::string at(const std::string& name) const { return (dir_ / name).string(); }
+  /// The InputError's message for resolving `spec` in the directory, or "resolved".
+  std::string message(const std::string& spec) const {
+    try {
+      resolve_sequence(at(spec));
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "resolved";
+  }
 
   /// (number, file name) pairs of a resolved sequence.
   static std::vector<std::pair<int64_t, std::string>> names(const std::vector<Frame>& frames) {
@@ -251,14 +260,6 @@ TEST_F(SequenceDir, FramesNamedByTheirNumberAlone) {
 
 TEST_F(SequenceDir, APatternMatchingNothingNamesAFileOfAnotherWidth) {
   touch({"drape.0001.obj", "drape.0002.obj", "coat.12.obj", "other.0001.ply"});
-  const auto message = [&](const std::string& spec) -> std::string {
-    try {
-      resolve_sequence(at(spec));
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "resolved";
-  };
   EXPECT_NE(message("drape.@.obj")
                 .find("'drape.0001.obj' has its frame number padded to 4 "
                       "digits: write %04d, #### or $F4"),
@@ -278,14 +279,6 @@ TEST_F(SequenceDir, APatternMatchingNothingNamesAFileOfAnotherWidth) {
 // "coat.0.obj" is frame 0 unpadded, not a number padded to one digit.
 TEST_F(SequenceDir, AnOtherWidthHintNeedsAFrameNumberWhereTheTokenGoes) {
   touch({"hat..obj", "coat.0.obj"});
-  const auto message = [&](const std::string& spec) -> std::string {
-    try {
-      resolve_sequence(at(spec));
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "resolved";
-  };
   EXPECT_EQ(message("hat.%04d.obj").find("has its frame number"), std::string::npos)
       << message("hat.%04d.obj");
   EXPECT_NE(message("coat.%04d.obj")
