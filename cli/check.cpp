@@ -482,10 +482,11 @@ int run_check(const CheckOptions& o) {
     junit_directory.emplace(junit_dir);
   }
   // So is a baseline that cannot be read, or that names objects this run does not have.
+  report::Inputs inputs;
+  inputs.sequence = o.scene.empty() ? o.sequence : o.scene;
+  if (scene_run) inputs.objects = object_inputs(resolved);
   std::optional<report::Baseline> baseline;
-  if (!o.baseline.empty())
-    baseline = report::Baseline::read(
-        o.baseline, scene_run ? object_inputs(resolved) : std::vector<report::ObjectInput>{});
+  if (!o.baseline.empty()) baseline = report::Baseline::read(o.baseline, inputs.objects);
 
   // The run's threads are the checker's and its readers' (checker_threads_for).
   const int threads = thread_count(o.threads);
@@ -517,9 +518,6 @@ int run_check(const CheckOptions& o) {
   report_settings.fail_on = *fail_on;
   if (!o.frames.empty()) report_settings.frames = o.frames;
   if (baseline) report_settings.baseline = o.baseline;
-  report::Inputs inputs;
-  inputs.sequence = o.scene.empty() ? o.sequence : o.scene;
-  if (scene_run) inputs.objects = object_inputs(resolved);
   // Each frame's record is written to the reports' temporaries as soon as it is checked and
   // dropped: a run holds one frame's pairs, never the sequence's. The reports appear only when
   // finish() renames them into place; an exception before that (a bad frame 7) unwinds the
